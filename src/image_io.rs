@@ -1,0 +1,157 @@
+//! The frame buffer to bytes and files, through the `image` crate. This is where the
+//! bottom-up frame is flipped to the top-down order of files, once. Every file is
+//! written whole or not at all: into a temporary file beside the target, then renamed.
+
+use std::io::{Cursor, Write};
+use std::path::Path;
+
+use image::codecs::bmp::BmpEncoder;
+use image::codecs::jpeg::JpegEncoder;
+use image::codecs::png::PngEncoder;
+use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
+use image::{DynamicImage, ExtendedColorType, ImageEncoder, ImageFormat, Rgb32FImage, RgbImage};
+
+use crate::render::Frame;
+
+/// The file formats `whitted` writes, chosen by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// PPM, plain (P3) or binary (P6).
+    Ppm {
+        binary: bool,
+    },
+    Png,
+    Bmp,
+    Jpeg,
+    /// OpenEXR, linear 32-bit float.
+    Exr,
+}
+
+impl Format {
+    /// The format for a path's extension (`binary_ppm` picks P6 over P3).
+    pub fn from_path(path: &Path, binary_ppm: bool) -> Result<Format, String> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        match ext.as_str() {
+            "ppm" => Ok(Format::Ppm { binary: binary_ppm }),
+            "png" => Ok(Format::Png),
+            "bmp" => Ok(Format::Bmp),
+            "jpg" | "jpeg" => Ok(Format::Jpeg),
+            "exr" => Ok(Format::Exr),
+            _ => Err(format!(
+                "{}: unknown image format (use .ppm, .png, .bmp, .jpg or .exr)",
+                path.display()
+            )),
+        }
+    }
+}
+
+/// A linear value to 8 bits: `round(clamp(c, 0, 1)·255)`, no gamma (SPEC §2).
+#[inline]
+pub fn to_byte(c: f32) -> u8 {
+    // NaN fails both comparisons of clamp's inputs; map it to 0 explicitly.
+    if c.is_nan() {
+        return 0;
+    }
+    (c.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// The frame as 8-bit RGB, row 0 at the TOP (the order of files and screens).
+pub fn to_rgb8(frame: &Frame) -> RgbImage {
+    let (w, h) = (frame.width, frame.height);
+    let mut bytes = Vec::with_capacity(w as usize * h as usize * 3);
+    for row in frame.pixels.chunks_exact(w as usize).rev() {
+        for p in row {
+            bytes.extend_from_slice(&[to_byte(p.x), to_byte(p.y), to_byte(p.z)]);
+        }
+    }
+    RgbImage::from_raw(w, h, bytes).expect("the buffer has w*h*3 bytes")
+}
+
+/// The frame as linear 32-bit float RGB, row 0 at the top.
+pub fn to_rgb32f(frame: &Frame) -> Rgb32FImage {
+    let (w, h) = (frame.width, frame.height);
+    let mut values = Vec::with_capacity(w as usize * h as usize * 3);
+    for row in frame.pixels.chunks_exact(w as usize).rev() {
+        for p in row {
+            values.extend_from_slice(&p.to_array());
+        }
+    }
+    Rgb32FImage::from_raw(w, h, values).expect("the buffer has w*h*3 values")
+}
+
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: {message}")]
+pub struct SaveError {
+    pub path: String,
+    pub message: String,
+}
+
+/// Encodes 8-bit RGB (top row first) in `format`.
+pub fn encode_rgb8(image: &RgbImage, format: Format, out: &mut dyn Write) -> Result<(), String> {
+    let (w, h) = image.dimensions();
+    let raw = image.as_raw();
+    let rgb = ExtendedColorType::Rgb8;
+    let result = match format {
+        Format::Ppm { binary } => {
+            let encoding = if binary {
+                SampleEncoding::Binary
+            } else {
+                SampleEncoding::Ascii
+            };
+            PnmEncoder::new(out)
+                .with_subtype(PnmSubtype::Pixmap(encoding))
+                .write_image(raw, w, h, rgb)
+        }
+        Format::Png => PngEncoder::new(out).write_image(raw, w, h, rgb),
+        Format::Bmp => BmpEncoder::new(&mut &mut *out).write_image(raw, w, h, rgb),
+        Format::Jpeg => JpegEncoder::new_with_quality(out, 95).write_image(raw, w, h, rgb),
+        Format::Exr => return Err("EXR is written from linear values, not bytes".into()),
+    };
+    result.map_err(|e| e.to_string())
+}
+
+/// Writes `bytes` into `path` atomically: a temporary file in the same folder, flushed
+/// and synced, then renamed over the target. On any error nothing is left behind.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
+    let err = |message: String| SaveError {
+        path: path.display().to_string(),
+        message,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut temp = tempfile::Builder::new()
+        .prefix(".whitted-")
+        .suffix(".part")
+        .tempfile_in(dir)
+        .map_err(|e| err(format!("cannot create a file in {}: {e}", dir.display())))?;
+    temp.write_all(bytes).map_err(|e| err(e.to_string()))?;
+    temp.as_file().sync_all().map_err(|e| err(e.to_string()))?;
+    temp.persist(path).map_err(|e| err(e.error.to_string()))?;
+    Ok(())
+}
+
+/// The frame encoded in `format`.
+pub fn encode(frame: &Frame, format: Format) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    match format {
+        Format::Exr => DynamicImage::ImageRgb32F(to_rgb32f(frame))
+            .write_to(&mut Cursor::new(&mut out), ImageFormat::OpenExr)
+            .map_err(|e| e.to_string())?,
+        _ => encode_rgb8(&to_rgb8(frame), format, &mut out)?,
+    }
+    Ok(out)
+}
+
+/// Saves the frame to `path` in `format`, atomically.
+pub fn save(frame: &Frame, path: &Path, format: Format) -> Result<(), SaveError> {
+    let bytes = encode(frame, format).map_err(|message| SaveError {
+        path: path.display().to_string(),
+        message: format!("cannot encode: {message}"),
+    })?;
+    write_atomically(path, &bytes)
+}

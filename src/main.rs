@@ -1,0 +1,265 @@
+//! The command line: parse, call the library, map errors to exit codes
+//! (0 success, 2 usage error, 1 anything else; one line on stderr).
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::{anyhow, Context};
+use clap::{Args, Parser, Subcommand};
+
+use whitted::image_io::{self, Format};
+use whitted::render::{self, Region, RenderControl, RenderOptions, Renderer};
+use whitted::scene::{self, Scene};
+
+#[derive(Parser)]
+#[command(
+    name = "whitted",
+    version,
+    about = "A Whitted-style ray tracer for scenes of spheres"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Open the viewer window on a scene (default: the built-in hw3 scene).
+    View {
+        /// A scene file (TOML).
+        scene: Option<PathBuf>,
+    },
+    /// Render without a window and write image files.
+    Render(RenderArgs),
+    /// Print a built-in scene as a scene file.
+    Scene {
+        /// The built-in scene: only "hw3".
+        #[arg(value_parser = ["hw3"])]
+        name: String,
+        /// Seed of the 48 small balls (2020 is the built-in scene).
+        #[arg(long, default_value_t = scene::HW3_DEFAULT_SEED)]
+        seed: u64,
+    },
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// A scene file (TOML); default: the built-in hw3 scene.
+    scene: Option<PathBuf>,
+    /// Output file, format by extension: .ppm .png .bmp .jpg .exr (repeatable).
+    /// Default: output.ppm and output.png.
+    #[arg(short, long = "output", value_name = "FILE")]
+    output: Vec<PathBuf>,
+    /// Write binary PPM (P6) instead of plain (P3).
+    #[arg(long)]
+    ppm_binary: bool,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    width: Option<u32>,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    height: Option<u32>,
+    /// Samples per pixel.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    spp: Option<u32>,
+    /// Maximum ray depth.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
+    depth: Option<u32>,
+    /// Sampling seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    /// Render only this rectangle: X,Y,W,H in output pixels, origin top-left.
+    #[arg(long, value_name = "X,Y,W,H", value_parser = parse_region)]
+    region: Option<Region>,
+    /// Use the slow f64 reference renderer.
+    #[arg(long)]
+    reference: bool,
+    /// No progress bar and no closing line.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn parse_region(text: &str) -> Result<Region, String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    let numbers: Result<Vec<u32>, _> = parts.iter().map(|p| p.trim().parse::<u32>()).collect();
+    match numbers.as_deref() {
+        Ok(&[x, y, width, height]) if width > 0 && height > 0 => Ok(Region {
+            x,
+            y,
+            width,
+            height,
+        }),
+        _ => Err("expected X,Y,W,H: four whole numbers, W and H at least 1".into()),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    let result = match cli.command {
+        None => view(None),
+        Some(Command::View { scene }) => view(scene.as_deref()),
+        Some(Command::Render(args)) => render_command(args),
+        Some(Command::Scene { name: _, seed }) => {
+            print!("{}", scene::hw3_toml(seed));
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("whitted: error: {}", one_line(&e));
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// The error and its causes on one line.
+fn one_line(e: &anyhow::Error) -> String {
+    e.chain()
+        .map(|c| c.to_string())
+        .collect::<Vec<_>>()
+        .join(": ")
+        .replace('\n', " ")
+}
+
+fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
+    match path {
+        None => Ok(scene::hw3_scene(scene::HW3_DEFAULT_SEED)),
+        Some(p) => Ok(Scene::load(p)?),
+    }
+}
+
+fn view(path: Option<&Path>) -> anyhow::Result<()> {
+    let scene = load_scene(path)?;
+    whitted::viewer::run(scene)
+}
+
+fn render_command(args: RenderArgs) -> anyhow::Result<()> {
+    // Output formats first: a bad extension is a usage error, found before any work.
+    let outputs: Vec<PathBuf> = if args.output.is_empty() {
+        vec!["output.ppm".into(), "output.png".into()]
+    } else {
+        args.output.clone()
+    };
+    let mut targets = Vec::new();
+    for path in &outputs {
+        match Format::from_path(path, args.ppm_binary) {
+            Ok(format) => targets.push((path.clone(), format)),
+            Err(message) => {
+                eprintln!("whitted: error: {message}");
+                std::process::exit(2);
+            }
+        }
+    }
+
+    let scene = load_scene(args.scene.as_deref())?;
+    let mut opts = RenderOptions::for_scene(&scene);
+    let image = &mut opts.image;
+    image.width = args.width.unwrap_or(image.width);
+    image.height = args.height.unwrap_or(image.height);
+    image.spp = args.spp.unwrap_or(image.spp);
+    image.max_depth = args.depth.unwrap_or(image.max_depth);
+    image.seed = args.seed.unwrap_or(image.seed);
+    opts.threads = args.threads.map(|t| t as usize);
+    opts.region = args.region;
+    if args.reference {
+        opts.renderer = Renderer::Reference;
+    }
+    opts.check()?;
+
+    let control = Arc::new(RenderControl::default());
+    {
+        let control = Arc::clone(&control);
+        ctrlc::set_handler(move || control.cancel())
+            .context("cannot install the interrupt handler")?;
+    }
+    let show_progress = !args.quiet && std::io::stderr().is_terminal();
+    let area = opts.area();
+    let total = u64::from(area.width) * u64::from(area.height) * u64::from(opts.image.spp);
+    let progress = show_progress.then(|| spawn_progress(Arc::clone(&control), total));
+
+    let result = render::render(&scene, &opts, &control);
+    if let Some((done, handle)) = progress {
+        done.store(true, std::sync::atomic::Ordering::Relaxed);
+        let _ = handle.join();
+    }
+    let (frame, stats) = result.map_err(|e| match e {
+        render::RenderError::Cancelled => anyhow!("interrupted: no file was written"),
+        other => anyhow!(other),
+    })?;
+
+    for (path, format) in &targets {
+        if control.is_cancelled() {
+            return Err(anyhow!(
+                "interrupted: stopped before writing {}",
+                path.display()
+            ));
+        }
+        image_io::save(&frame, path, *format)?;
+        if !args.quiet {
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    if !args.quiet {
+        eprintln!(
+            "rendered {} {}x{} ({} spp, depth {}) in {:.3} s: {} rays, {:.1} Mrays/s",
+            scene.name,
+            area.width,
+            area.height,
+            opts.image.spp,
+            opts.image.max_depth,
+            stats.seconds,
+            stats.rays.total(),
+            stats.mrays_per_second()
+        );
+    }
+    Ok(())
+}
+
+/// A progress bar on stderr that appears only once a render has run for a second.
+fn spawn_progress(
+    control: Arc<RenderControl>,
+    total: u64,
+) -> (
+    Arc<std::sync::atomic::AtomicBool>,
+    std::thread::JoinHandle<()>,
+) {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let done = Arc::new(AtomicBool::new(false));
+    let finished = Arc::clone(&done);
+    let handle = std::thread::spawn(move || {
+        let start = Instant::now();
+        let mut bar: Option<indicatif::ProgressBar> = None;
+        while !finished.load(Ordering::Relaxed) {
+            std::thread::sleep(Duration::from_millis(50));
+            if bar.is_none() && start.elapsed() > Duration::from_secs(1) {
+                let b = indicatif::ProgressBar::new(total);
+                b.set_style(
+                    indicatif::ProgressStyle::with_template(
+                        "{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}",
+                    )
+                    .expect("a valid template"),
+                );
+                bar = Some(b);
+            }
+            if let Some(b) = &bar {
+                b.set_position(control.pixels_done());
+            }
+        }
+        if let Some(b) = bar {
+            b.finish_and_clear();
+        }
+    });
+    (done, handle)
+}

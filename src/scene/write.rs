@@ -1,0 +1,125 @@
+//! Scenes back to TOML text in the format of SPEC §4 (through `toml`'s serializer).
+
+use serde::Serialize;
+
+use super::{CameraSpec, Scene};
+
+#[derive(Serialize)]
+struct OutScene {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    camera: Option<OutCamera>,
+    image: OutImage,
+    sky: OutSky,
+    light: Vec<OutLight>,
+    sphere: Vec<OutSphere>,
+}
+
+#[derive(Serialize)]
+#[serde(untagged)]
+enum OutCamera {
+    LookAt {
+        look_from: [f64; 3],
+        look_at: [f64; 3],
+        up: [f64; 3],
+        vfov: f64,
+    },
+    Frame {
+        origin: [f64; 3],
+        lower_left: [f64; 3],
+        horizontal: [f64; 3],
+        vertical: [f64; 3],
+    },
+}
+
+#[derive(Serialize)]
+struct OutImage {
+    width: u32,
+    height: u32,
+    max_depth: u32,
+    spp: u32,
+    seed: u64,
+}
+
+#[derive(Serialize)]
+struct OutSky {
+    down: [f64; 3],
+    up: [f64; 3],
+}
+
+#[derive(Serialize)]
+struct OutLight {
+    position: [f64; 3],
+    intensity: [f64; 3],
+}
+
+#[derive(Serialize)]
+struct OutSphere {
+    center: [f64; 3],
+    radius: f64,
+    color: [f64; 3],
+    reflect: f64,
+    transmit: f64,
+    ior: f64,
+}
+
+/// The scene as TOML; loading the text gives the same scene back.
+pub fn to_toml(scene: &Scene) -> String {
+    let out = OutScene {
+        camera: scene.camera.map(|c| match c {
+            CameraSpec::LookAt {
+                look_from,
+                look_at,
+                up,
+                vfov,
+            } => OutCamera::LookAt {
+                look_from: look_from.to_array(),
+                look_at: look_at.to_array(),
+                up: up.to_array(),
+                vfov,
+            },
+            CameraSpec::Frame {
+                origin,
+                lower_left,
+                horizontal,
+                vertical,
+            } => OutCamera::Frame {
+                origin: origin.to_array(),
+                lower_left: lower_left.to_array(),
+                horizontal: horizontal.to_array(),
+                vertical: vertical.to_array(),
+            },
+        }),
+        image: OutImage {
+            width: scene.image.width,
+            height: scene.image.height,
+            max_depth: scene.image.max_depth,
+            spp: scene.image.spp,
+            seed: scene.image.seed,
+        },
+        sky: OutSky {
+            down: scene.sky.down.to_array(),
+            up: scene.sky.up.to_array(),
+        },
+        light: scene
+            .lights
+            .iter()
+            .map(|l| OutLight {
+                position: l.position.to_array(),
+                intensity: l.intensity.to_array(),
+            })
+            .collect(),
+        sphere: scene
+            .spheres
+            .iter()
+            .map(|s| OutSphere {
+                center: s.center.to_array(),
+                radius: s.radius,
+                color: s.color.to_array(),
+                reflect: s.reflect,
+                transmit: s.transmit,
+                ior: s.ior,
+            })
+            .collect(),
+    };
+    toml::to_string(&out).expect("a scene of finite numbers always serialises")
+}

@@ -1,0 +1,145 @@
+//! The fast tracer: the model of SPEC §2 in `f32` colours and directions, with the
+//! scene compiled once ([`crate::accel`]) and the intersection maths in `f64` where
+//! `f32` cannot hold.
+
+use glam::Vec3;
+
+use super::{RayCounts, SampleTracer};
+use crate::accel::{Query, Spheres};
+use crate::camera::Camera;
+use crate::model::{self, Branches, Side};
+use crate::scene::Scene;
+
+#[derive(Clone, Copy)]
+struct Material {
+    color: Vec3,
+    w_r: f32,
+    w_t: f32,
+    ior: f32,
+    branches: Branches,
+}
+
+#[derive(Clone, Copy)]
+struct Light {
+    position: Vec3,
+    intensity: Vec3,
+}
+
+pub struct FastTracer {
+    spheres: Spheres,
+    materials: Vec<Material>,
+    lights: Vec<Light>,
+    sky_down: Vec3,
+    sky_up: Vec3,
+    origin: Vec3,
+    lower_left: Vec3,
+    horizontal: Vec3,
+    vertical: Vec3,
+    max_depth: u32,
+}
+
+impl FastTracer {
+    pub fn new(scene: &Scene, camera: &Camera, max_depth: u32) -> Self {
+        FastTracer {
+            spheres: Spheres::new(&scene.spheres),
+            materials: scene
+                .spheres
+                .iter()
+                .map(|s| Material {
+                    color: s.color.as_vec3(),
+                    w_r: s.reflect as f32,
+                    w_t: s.transmit as f32,
+                    ior: s.ior as f32,
+                    branches: Branches::of(s.reflect, s.transmit),
+                })
+                .collect(),
+            lights: scene
+                .lights
+                .iter()
+                .map(|l| Light {
+                    position: l.position.as_vec3(),
+                    intensity: l.intensity.as_vec3(),
+                })
+                .collect(),
+            sky_down: scene.sky.down.as_vec3(),
+            sky_up: scene.sky.up.as_vec3(),
+            origin: camera.origin.as_vec3(),
+            lower_left: camera.lower_left.as_vec3(),
+            horizontal: camera.horizontal.as_vec3(),
+            vertical: camera.vertical.as_vec3(),
+            max_depth,
+        }
+    }
+
+    fn trace(&self, ray: &Query, depth: u32, counts: &mut RayCounts) -> Vec3 {
+        if depth >= self.max_depth {
+            return model::sky(ray.dir, self.sky_down, self.sky_up);
+        }
+        if depth == 0 {
+            counts.primary += 1;
+        } else {
+            counts.secondary += 1;
+        }
+        let Some(hit) = self.spheres.closest(ray) else {
+            return model::sky(ray.dir, self.sky_down, self.sky_up);
+        };
+        let m = &self.materials[hit.sphere as usize];
+        let front = hit.entering;
+        let n = hit.normal.as_vec3();
+        let nf = if front { n } else { -n };
+        let point = hit.point.as_vec3();
+        let spawn = |dir: Vec3, inside: bool| Query {
+            origin: point,
+            dir,
+            from: Some((hit.sphere, Side::inside(inside))),
+        };
+
+        let mut local = Vec3::ZERO;
+        if m.branches.local {
+            for light in &self.lights {
+                // The light direction from the f64 point: the f32 one may sit off the sphere.
+                let to_light = light.position.as_dvec3() - hit.point;
+                let dist = to_light.length();
+                let l = (to_light / dist).as_vec3();
+                let cos = nf.dot(l);
+                if cos > 0.0 {
+                    counts.shadow += 1;
+                    let shadow = self.spheres.shadow(&spawn(l, !front), dist);
+                    local += model::diffuse(m.color, light.intensity, cos, shadow);
+                }
+            }
+        }
+        let reflected = if m.branches.reflect {
+            let dir = model::reflect(ray.dir, n).normalize();
+            self.trace(&spawn(dir, !front), depth + 1, counts)
+        } else {
+            Vec3::ZERO
+        };
+        let transmitted = if m.branches.transmit {
+            let (dir, crosses) = model::transmit(ray.dir, n, front, m.ior);
+            self.trace(&spawn(dir, front == crosses), depth + 1, counts)
+        } else {
+            Vec3::ZERO
+        };
+        model::combine(m.w_r, m.w_t, local, reflected, transmitted)
+    }
+}
+
+impl SampleTracer for FastTracer {
+    fn sample(&self, s: f32, t: f32, counts: &mut RayCounts) -> Vec3 {
+        let dir = model::primary_direction(
+            self.origin,
+            self.lower_left,
+            self.horizontal,
+            self.vertical,
+            s,
+            t,
+        );
+        let ray = Query {
+            origin: self.origin,
+            dir,
+            from: None,
+        };
+        self.trace(&ray, 0, counts)
+    }
+}

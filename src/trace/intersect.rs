@@ -1,0 +1,63 @@
+//! Ray/sphere intersection in the numerically stable form (Ray Tracing Gems ch. 7):
+//! the discriminant from the closest point of the line to the centre, and roots that
+//! never subtract nearly equal numbers. Generic over the precision.
+
+use crate::model::{Real, Vector};
+
+/// The two roots `t_near ≤ t_far` of a unit-direction ray `o + t·d` with the sphere
+/// (`f = o − c`), and the sphere's outward normals there, or `None` on a miss.
+#[derive(Clone, Copy, Debug)]
+pub struct Roots<V: Vector> {
+    pub near: V::R,
+    pub far: V::R,
+    /// `l = f + (−f·d)·d`: centre to the closest point of the line.
+    pub closest: V,
+    /// `√(r² − l·l)`: half the chord.
+    pub half_chord: V::R,
+}
+
+impl<V: Vector> Roots<V> {
+    /// Outward unit normal at the near root: `(l − half_chord·d)/r`, no cancellation.
+    #[inline]
+    pub fn normal_near(&self, d: V, radius: V::R) -> V {
+        (self.closest - d * self.half_chord) / radius
+    }
+
+    /// Outward unit normal at the far root.
+    #[inline]
+    pub fn normal_far(&self, d: V, radius: V::R) -> V {
+        (self.closest + d * self.half_chord) / radius
+    }
+}
+
+/// Both roots of the unit-direction ray `o + t·d` with the sphere `(c, r)`.
+#[inline]
+pub fn roots<V: Vector>(o: V, d: V, c: V, r: V::R) -> Option<Roots<V>> {
+    let f = o - c;
+    let bp = -f.dot(d);
+    let l = f + d * bp;
+    let disc = r * r - l.dot(l);
+    if disc < V::R::ZERO {
+        return None;
+    }
+    let half_chord = disc.sqrt();
+    // q = bp + sign(bp)·√disc; the roots are c/q and q (with a = d·d = 1).
+    let q = if bp >= V::R::ZERO {
+        bp + half_chord
+    } else {
+        bp - half_chord
+    };
+    let cterm = f.dot(f) - r * r;
+    let (t0, t1) = if q == V::R::ZERO {
+        (V::R::ZERO, V::R::ZERO)
+    } else {
+        (cterm / q, q)
+    };
+    let (near, far) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+    Some(Roots {
+        near,
+        far,
+        closest: l,
+        half_chord,
+    })
+}

@@ -1,0 +1,35 @@
+//! The model of SPEC §2 in two implementations that compute the same function:
+//! [`fast`], the `f32` tracer used for every image, and [`reference`], a plain `f64`
+//! tracer written for clarity, against which the tests measure the fast one.
+
+pub mod fast;
+pub mod intersect;
+pub mod reference;
+
+use glam::Vec3;
+
+/// Rays cast while rendering, by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    pub primary: u64,
+    pub secondary: u64,
+    pub shadow: u64,
+}
+
+impl RayCounts {
+    pub fn total(&self) -> u64 {
+        self.primary + self.secondary + self.shadow
+    }
+
+    pub fn add(&mut self, other: &RayCounts) {
+        self.primary += other.primary;
+        self.secondary += other.secondary;
+        self.shadow += other.shadow;
+    }
+}
+
+/// Something that computes the linear RGB of one sample.
+pub trait SampleTracer: Sync {
+    /// The colour of the ray through film position `(s, t)` ∈ [0,1]² (`t` from the bottom).
+    fn sample(&self, s: f32, t: f32, counts: &mut RayCounts) -> Vec3;
+}
