@@ -36,6 +36,17 @@ pub struct FastTracer {
     horizontal: Vec3,
     vertical: Vec3,
     max_depth: u32,
+    /// Contribution cutoff: a branch whose path weight is below it is not traced.
+    cutoff: f32,
+    /// An upper bound of any traced colour component (SPEC §2 colours are convex mixes
+    /// of sky colours and light sums), to turn skipped weight into an error bound.
+    value_bound: f32,
+}
+
+/// What a sample skipped under the contribution cutoff.
+#[derive(Clone, Copy, Debug, Default)]
+struct Skipped {
+    weight: f32,
 }
 
 impl FastTracer {
@@ -68,10 +79,39 @@ impl FastTracer {
             horizontal: camera.horizontal.as_vec3(),
             vertical: camera.vertical.as_vec3(),
             max_depth,
+            cutoff: 0.0,
+            value_bound: value_bound(scene),
         }
     }
 
-    fn trace(&self, ray: &Query, depth: u32, counts: &mut RayCounts) -> Vec3 {
+    /// Skip every branch whose path weight (the product of the mix weights of step 7
+    /// down to it) is below `cutoff`; 0 traces everything (exact).
+    pub fn with_cutoff(mut self, cutoff: f32) -> Self {
+        self.cutoff = cutoff.max(0.0);
+        self
+    }
+
+    /// Whether a branch of path weight `w` is traced; if not, its weight is recorded.
+    #[inline]
+    fn keep(&self, w: f32, skipped: &mut Skipped) -> bool {
+        if w == 0.0 {
+            return false;
+        }
+        if w < self.cutoff {
+            skipped.weight += w;
+            return false;
+        }
+        true
+    }
+
+    fn trace(
+        &self,
+        ray: &Query,
+        depth: u32,
+        weight: f32,
+        counts: &mut RayCounts,
+        skipped: &mut Skipped,
+    ) -> Vec3 {
         if depth >= self.max_depth {
             return model::sky(ray.dir, self.sky_down, self.sky_up);
         }
@@ -95,7 +135,8 @@ impl FastTracer {
         };
 
         let mut local = Vec3::ZERO;
-        if m.branches.local {
+        let w_local = weight * (1.0 - m.w_t) * (1.0 - m.w_r);
+        if m.branches.local && self.keep(w_local, skipped) {
             for light in &self.lights {
                 // The light direction from the f64 point: the f32 one may sit off the sphere.
                 let to_light = light.position.as_dvec3() - hit.point;
@@ -109,15 +150,23 @@ impl FastTracer {
                 }
             }
         }
-        let reflected = if m.branches.reflect {
+        let w_reflect = weight * (1.0 - m.w_t) * m.w_r;
+        let reflected = if m.branches.reflect && self.keep(w_reflect, skipped) {
             let dir = model::reflect(ray.dir, n).normalize();
-            self.trace(&spawn(dir, !front), depth + 1, counts)
+            self.trace(&spawn(dir, !front), depth + 1, w_reflect, counts, skipped)
         } else {
             Vec3::ZERO
         };
-        let transmitted = if m.branches.transmit {
+        let w_transmit = weight * m.w_t;
+        let transmitted = if m.branches.transmit && self.keep(w_transmit, skipped) {
             let (dir, crosses) = model::transmit(ray.dir, n, front, m.ior);
-            self.trace(&spawn(dir, front == crosses), depth + 1, counts)
+            self.trace(
+                &spawn(dir, front == crosses),
+                depth + 1,
+                w_transmit,
+                counts,
+                skipped,
+            )
         } else {
             Vec3::ZERO
         };
@@ -125,8 +174,20 @@ impl FastTracer {
     }
 }
 
+/// The largest colour component any trace can return: sky colours and, for local
+/// shading, the sum over lights of the brightest component (kd ≤ 1, cos ≤ 1, s ≤ 1).
+fn value_bound(scene: &Scene) -> f32 {
+    let sky = scene.sky.down.max_element().max(scene.sky.up.max_element());
+    let lights: f64 = scene.lights.iter().map(|l| l.intensity.max_element()).sum();
+    sky.max(lights) as f32
+}
+
 impl SampleTracer for FastTracer {
     fn sample(&self, s: f32, t: f32, counts: &mut RayCounts) -> Vec3 {
+        self.sample_bounded(s, t, counts).0
+    }
+
+    fn sample_bounded(&self, s: f32, t: f32, counts: &mut RayCounts) -> (Vec3, f32) {
         let dir = model::primary_direction(
             self.origin,
             self.lower_left,
@@ -140,6 +201,8 @@ impl SampleTracer for FastTracer {
             dir,
             from: None,
         };
-        self.trace(&ray, 0, counts)
+        let mut skipped = Skipped::default();
+        let colour = self.trace(&ray, 0, 1.0, counts, &mut skipped);
+        (colour, skipped.weight * self.value_bound)
     }
 }
