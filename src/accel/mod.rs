@@ -143,6 +143,12 @@ impl Spheres {
         self
     }
 
+    pub fn debug_stats(&self) {
+        for g in self.eye.iter().chain(&self.lights) {
+            g.debug_stats();
+        }
+    }
+
     pub fn len(&self) -> usize {
         self.center.len()
     }
