@@ -55,7 +55,11 @@ fn median(values: &mut [f64]) -> f64 {
 }
 
 /// Renders `runs` times (after one warm-up) and takes medians.
-pub fn time_render(scene: &Scene, opts: &RenderOptions, runs: usize) -> Result<Timing, RenderError> {
+pub fn time_render(
+    scene: &Scene,
+    opts: &RenderOptions,
+    runs: usize,
+) -> Result<Timing, RenderError> {
     let control = RenderControl::default();
     render(scene, opts, &control)?; // warm-up: caches, thread pool, page faults
     let mut trace = Vec::with_capacity(runs);

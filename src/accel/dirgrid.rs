@@ -104,9 +104,18 @@ impl DirGrid {
 
     pub fn debug_stats(&self) {
         let cells = self.offsets.len() - 1;
-        let nonempty = (0..cells).filter(|&c| self.offsets[c + 1] > self.offsets[c]).count();
-        let max = (0..cells).map(|c| self.offsets[c + 1] - self.offsets[c]).max().unwrap_or(0);
-        eprintln!("cells {cells} nonempty {nonempty} items {} max {max} always {}", self.items.len(), self.always.len());
+        let nonempty = (0..cells)
+            .filter(|&c| self.offsets[c + 1] > self.offsets[c])
+            .count();
+        let max = (0..cells)
+            .map(|c| self.offsets[c + 1] - self.offsets[c])
+            .max()
+            .unwrap_or(0);
+        eprintln!(
+            "cells {cells} nonempty {nonempty} items {} max {max} always {}",
+            self.items.len(),
+            self.always.len()
+        );
     }
 
     /// The cell of direction `d` (any length, not zero).
@@ -144,7 +153,8 @@ struct CellCones {
 impl CellCones {
     /// The cones for `n` cells per side, computed once per process.
     fn shared(n: u32) -> std::sync::Arc<CellCones> {
-        static CACHE: std::sync::Mutex<Vec<std::sync::Arc<CellCones>>> = std::sync::Mutex::new(Vec::new());
+        static CACHE: std::sync::Mutex<Vec<std::sync::Arc<CellCones>>> =
+            std::sync::Mutex::new(Vec::new());
         let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(c) = cache.iter().find(|c| c.n == n) {
             return c.clone();
@@ -244,7 +254,19 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
     }
     let range = |x_lo: f64, x_hi: f64| -> (f64, f64) {
         if a_lo <= 0.0 {
-            return (-1.0, 1.0);
+            // The box reaches the face plane: a → 0⁺ sends x/a to ±∞ unless x keeps
+            // one sign, in which case the largest a bounds it on one side.
+            let min = if x_lo >= 0.0 {
+                x_lo / a_hi
+            } else {
+                f64::NEG_INFINITY
+            };
+            let max = if x_hi <= 0.0 {
+                x_hi / a_hi
+            } else {
+                f64::INFINITY
+            };
+            return (min, max);
         }
         // x/a over the box: smallest with the largest a when x ≥ 0, and so on.
         let min = x_lo / if x_lo >= 0.0 { a_hi } else { a_lo };
@@ -261,10 +283,5 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
         let x = x.clamp(-1.0, 1.0);
         (((x + 1.0) * 0.5 * f64::from(n)) as u32).min(n - 1)
     };
-    Some([
-        to_cell(u_lo),
-        to_cell(u_hi),
-        to_cell(v_lo),
-        to_cell(v_hi),
-    ])
+    Some([to_cell(u_lo), to_cell(u_hi), to_cell(v_lo), to_cell(v_hi)])
 }

@@ -6,6 +6,7 @@ mod bvh;
 mod dirgrid;
 
 use glam::{DVec3, Vec3, Vec4};
+use rayon::prelude::*;
 
 use bvh::{Aabb, Bvh};
 use dirgrid::DirGrid;
@@ -135,11 +136,14 @@ impl Spheres {
             .zip(self.radius.iter().copied())
             .collect();
         let n = grid_resolution(list.len());
-        self.eye = Some(DirGrid::build(eye, &list, n));
-        self.lights = lights
-            .iter()
+        // All grids at once: they are independent.
+        let points: Vec<DVec3> = std::iter::once(eye).chain(lights.iter().copied()).collect();
+        let mut grids: Vec<DirGrid> = points
+            .par_iter()
             .map(|&p| DirGrid::build(p, &list, n))
             .collect();
+        self.lights = grids.split_off(1);
+        self.eye = grids.pop();
         self
     }
 
