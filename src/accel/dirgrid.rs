@@ -10,7 +10,7 @@ use glam::{DVec3, Vec3};
 
 pub struct DirGrid {
     /// The point every ray of the grid passes through.
-    pub centre: Vec3,
+    pub centre: DVec3,
     /// Cells per face side.
     n: u32,
     /// Cell `c` lists `items[offsets[c]..offsets[c+1]]`.
@@ -93,7 +93,7 @@ impl DirGrid {
         }
         let near = items.iter().map(|&k| near_of[k as usize]).collect();
         DirGrid {
-            centre: centre.as_vec3(),
+            centre,
             n,
             offsets,
             items,
