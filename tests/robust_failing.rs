@@ -1,0 +1,40 @@
+//! Issue 4 tests that the fast path does not pass yet, kept apart so that the lead (who
+//! owns `src/accel`, `src/trace/fast.rs` and `src/trace/intersect.rs`) can fix the
+//! causes and then move them into the other `robust*.rs` files. Each test names its
+//! cause; the report of the `robust` branch has the figures and a patch.
+//!
+//! Causes, as measured (all three disappear with the patch in the report):
+//! 1. `accel` promotes the `f32` direction to `f64` but does not renormalise it, while
+//!    `intersect::roots` assumes `d·d = 1`. An `f32`-normalised direction has
+//!    `|d·d − 1|` up to ~1e-7, so `l = f + (−f·d)·d` and the discriminant are off by
+//!    about `|f|·1e-7`: the error grows with the distance to the sphere's *centre*.
+//!    On a ground of radius 1e5 the hit point moves by 5.7e-4 at t = 1.83 (relative
+//!    error 3e-4), enough to move contact shadows by a pixel.
+//! 2. `Query::origin` is `f32`: a spawn point is rounded to half an `f32` ulp of its
+//!    coordinates (3e-5 at 1e3, 5e-4 at 1e4), which is a large part of a small ball
+//!    (r = 1e-3) far from the world origin; `Query::t_min` (4·ε₃₂·|o|, 4.8e-3 at 1e4)
+//!    then also hides nearby spheres from shadow rays.
+//! 3. The primary direction is computed in `f32` as `LL + s·H + t·V − O`: with the
+//!    camera at 1e4 this cancels and loses ~1e-3 of the film position.
+
+mod robust_support;
+
+use robust_support::*;
+use whitted::render::Renderer;
+
+/// Causes 1 (ground-1e5, ground-1e6, facing-mirrors), 2 (tiny-far,
+/// hw3-translated-1e4) and 3 (hw3-translated-1e4).
+#[test]
+fn fast_matches_reference_on_the_remaining_stress_scenes() {
+    println!("\n{SCENE_TABLE_HEADER}");
+    let failures = check_fast_vs_reference(FAILING_FAST_VS_REFERENCE, 320, 180);
+    assert!(failures.is_empty(), "{failures:?}");
+}
+
+/// Causes 2 and 3: hw3 translated by (1e4, 1e4, 1e4), fast tracer, against hw3.
+#[test]
+fn translated_hw3_renders_like_hw3_with_the_fast_tracer() {
+    println!("\n{TRANSFORM_TABLE_HEADER}");
+    let failures = check_transforms(Renderer::Fast, &["translate (1e4,1e4,1e4)"], 320, 180);
+    assert!(failures.is_empty(), "{failures:?}");
+}
