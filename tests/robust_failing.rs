@@ -19,6 +19,7 @@
 
 mod robust_support;
 
+use robust_support::cases::{self, Truth};
 use robust_support::*;
 use whitted::render::Renderer;
 
@@ -37,4 +38,19 @@ fn translated_hw3_renders_like_hw3_with_the_fast_tracer() {
     println!("\n{TRANSFORM_TABLE_HEADER}");
     let failures = check_transforms(Renderer::Fast, &["translate (1e4,1e4,1e4)"], 320, 180);
     assert!(failures.is_empty(), "{failures:?}");
+}
+
+/// Cause 1: the ground of radius 1e5 at grazing angles, relative error of t ≤ 1e-6
+/// against `f64` on the very ray of the query.
+#[test]
+fn huge_ground_at_grazing_angles_keeps_t() {
+    let (_, _, max) = cases::ground_grazing(Truth::QueryRay, 1e5);
+    assert!(max <= 1e-6, "max relative error {max:e}");
+}
+
+/// Cause 2: inward rays against the far exit of the unrounded `f64` spawn point.
+#[test]
+fn inward_rays_find_the_exit_of_the_unrounded_spawn_point() {
+    let s = cases::reintersection(Truth::Unrounded, 1000).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((s.outward_rehits, s.shadowed, s.inward_misses), (0, 0, 0));
 }

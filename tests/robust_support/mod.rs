@@ -4,6 +4,8 @@
 //! and counts non-finite samples before they are zeroed.
 #![allow(dead_code)]
 
+pub mod cases;
+
 use std::path::PathBuf;
 
 use glam::{DVec3, Vec3};
@@ -470,3 +472,72 @@ pub const SCENE_TABLE_HEADER: &str =
     "scene                   off>1     off % max diff  NaN/Inf    fast s     ref s";
 pub const TRANSFORM_TABLE_HEADER: &str =
     "transform                tracer        off>1     off % max diff  NaN/Inf";
+
+/// A fast-path query from an `f64` spawn point (rounded as `accel::Query` stores it)
+/// and an `f64` direction (rounded to `f32`, renormalised in `f32`): the one place to
+/// change if the query's types change.
+pub fn query(
+    origin: DVec3,
+    dir: DVec3,
+    from: Option<(u32, whitted::model::Side)>,
+) -> whitted::accel::Query {
+    whitted::accel::Query {
+        origin: origin.as_vec3(),
+        dir: dir.as_vec3().normalize(),
+        from,
+    }
+}
+
+/// The ray the fast path actually traces for a query: its origin and direction in
+/// `f64`, the direction normalised in `f64`.
+pub fn query_ray(q: &whitted::accel::Query) -> (DVec3, DVec3) {
+    (q.origin.as_dvec3(), q.dir.as_dvec3().normalize())
+}
+
+/// Independent `f64` ray/sphere roots (unit `d`): `(near, far)`, written here rather
+/// than taken from `trace::intersect` so that the tests do not check it against itself.
+/// Distance from the centre to the line via the cross product; roots from the chord.
+pub fn roots64(o: DVec3, d: DVec3, c: DVec3, r: f64) -> Option<(f64, f64)> {
+    let f = c - o;
+    let along = f.dot(d);
+    let off = f.cross(d).length();
+    if off > r {
+        return None;
+    }
+    let half = ((r - off) * (r + off)).sqrt();
+    // Near root without cancellation: (|f|² − r²)/(along + half) when along > 0.
+    let far_abs = along.abs() + half;
+    let c_term = (f.length() - r) * (f.length() + r);
+    if along >= 0.0 {
+        Some((c_term / far_abs, far_abs))
+    } else {
+        Some((-far_abs, -c_term / far_abs))
+    }
+}
+
+/// Log-uniform `10^U(lo, hi)`.
+pub fn log_uniform(lo: f64, hi: f64) -> impl proptest::strategy::Strategy<Value = f64> {
+    use proptest::strategy::Strategy;
+    (lo..hi).prop_map(|e: f64| 10f64.powf(e))
+}
+
+/// A uniformly distributed unit vector.
+pub fn unit_vector() -> impl proptest::strategy::Strategy<Value = DVec3> {
+    use proptest::strategy::Strategy;
+    (-1.0f64..1.0, 0.0f64..std::f64::consts::TAU).prop_map(|(z, phi)| {
+        let s = (1.0 - z * z).sqrt();
+        DVec3::new(s * phi.cos(), s * phi.sin(), z)
+    })
+}
+
+/// A unit vector in the hemisphere around `n`, at least `min_cos` from the tangent plane.
+pub fn in_hemisphere(n: DVec3, u: DVec3, min_cos: f64) -> DVec3 {
+    let mut v = if u.dot(n) < 0.0 { -u } else { u };
+    let cos = v.dot(n);
+    if cos < min_cos {
+        v = (v - n * cos).normalize_or(n.any_orthonormal_vector())
+            * (1.0 - min_cos * min_cos).sqrt()
+            + n * min_cos;
+    }
+    v.normalize()
+}
