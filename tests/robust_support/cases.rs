@@ -257,3 +257,67 @@ pub fn ground_grazing(truth: Truth, radius: f64) -> (u64, f64, f64) {
     );
     (n, median, max)
 }
+
+/// An index of refraction 1 + 10^U(−3, 0.2) (1.001 to 2.58).
+pub fn ior() -> impl Strategy<Value = f64> {
+    log_uniform(-3.0, 0.2).prop_map(|x| 1.0 + x)
+}
+
+/// sin of the angle between two vectors, in `f64`.
+pub fn sin_between(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length() / (a.length() * b.length())
+}
+
+/// Entry/exit symmetry through the fast queries: a ray refracted into a ball leaves it
+/// at the angle it came in at (the chord makes equal angles with both normals):
+/// |sin θ_out − sin θ_in| ≤ 1e-5. Balls of radius 10^U(−3,5) with |centre| up to 1e4,
+/// those with |centre| > `max_centre_over_radius`·r left out. Returns (max error, balls).
+pub fn refraction_symmetry(max_centre_over_radius: f64) -> Result<(f64, u64), String> {
+    let worst = RefCell::new((0.0f64, 0u64));
+    let result = runner(5_000)
+        .run(&(sphere_and_eye(), ior()), |((c, r, eye, aim), ior)| {
+            if c.length() > max_centre_over_radius * r {
+                return Ok(());
+            }
+            let set = Spheres::new(&[Sphere::new(c, r)]);
+            let primary = query(eye, aim - eye, None);
+            let Some(hit) = set.closest(&primary) else {
+                return Ok(());
+            };
+            let d = primary.dir;
+            let (inside, crosses) = model::transmit(d, hit.normal.as_vec3(), true, ior as f32);
+            if !crosses {
+                // Rounding can make k < 0 at grazing entry; then it reflects (tested below).
+                return Ok(());
+            }
+            let q = query(hit.point, inside.as_dvec3(), Some((0, Side::Inward)));
+            let exit = set.closest(&q);
+            prop_assert!(exit.is_some(), "the refracted ray must find the exit");
+            let exit = exit.unwrap();
+            prop_assert!(!exit.entering);
+            let (out, crosses) = model::transmit(q.dir, exit.normal.as_vec3(), false, ior as f32);
+            prop_assert!(out.is_finite());
+            prop_assert!(
+                crosses,
+                "a chord's exit angle equals its entry angle: no TIR"
+            );
+            let sin_in = sin_between(d.as_dvec3(), hit.normal);
+            let sin_out = sin_between(out.as_dvec3(), exit.normal);
+            let err = (sin_out - sin_in).abs();
+            let mut w = worst.borrow_mut();
+            w.0 = w.0.max(err);
+            w.1 += 1;
+            prop_assert!(
+                err <= 1e-5,
+                "r {r:e} |c| {:e}: sin in {sin_in} out {sin_out}",
+                c.length()
+            );
+            Ok(())
+        })
+        .map_err(|e| e.to_string());
+    let (err, n) = worst.into_inner();
+    println!(
+        "entry/exit symmetry (|c| ≤ {max_centre_over_radius:e} r): {n} balls, max |sin θout − sin θin| {err:.2e}"
+    );
+    result.map(|()| (err, n))
+}
