@@ -1,7 +1,6 @@
 //! Issue 4, the stress scenes: the files load, say what they stress and hold what the
 //! generator in `robust_support` builds; the fast tracer matches the f64 reference on
-//! them; moving or scaling hw3 does not change its image. The scenes and cases on which
-//! the fast tracer does not match yet are checked in `robust_failing.rs`.
+//! every one of them; moving or scaling hw3 does not change its image.
 //!
 //! `WHITTED_WRITE_STRESS=1 cargo test --release --test robust_scenes` rewrites the files.
 
@@ -64,11 +63,7 @@ fn stress_files_load_and_match_their_generator() {
 /// level, 0 non-finite samples.
 #[test]
 fn fast_matches_reference_on_the_stress_scenes() {
-    let names: Vec<&str> = stress_scenes()
-        .iter()
-        .map(|s| s.name)
-        .filter(|n| !FAILING_FAST_VS_REFERENCE.contains(n))
-        .collect();
+    let names: Vec<&str> = stress_scenes().iter().map(|s| s.name).collect();
     println!("\n{SCENE_TABLE_HEADER}");
     let failures = check_fast_vs_reference(&names, W, H);
     assert!(failures.is_empty(), "{failures:?}");
@@ -76,16 +71,12 @@ fn fast_matches_reference_on_the_stress_scenes() {
 
 /// Scaling by 1e-3 or 1e3 or translating by 1e4 changes nothing in the shading model
 /// (no distance fall-off), so the image must stay the same: at most 0.1% of the pixels
-/// off by more than one level. (The fast tracer's translation is in robust_failing.rs.)
+/// off by more than one level, with either tracer.
 #[test]
 fn transformed_hw3_renders_like_hw3() {
     println!("\n{TRANSFORM_TABLE_HEADER}");
-    let mut failures = check_transforms(Renderer::Fast, &["scale 1e-3", "scale 1e3"], W, H);
-    failures.extend(check_transforms(
-        Renderer::Reference,
-        &["scale 1e-3", "scale 1e3", "translate (1e4,1e4,1e4)"],
-        W,
-        H,
-    ));
+    let all = ["scale 1e-3", "scale 1e3", "translate (1e4,1e4,1e4)"];
+    let mut failures = check_transforms(Renderer::Fast, &all, W, H);
+    failures.extend(check_transforms(Renderer::Reference, &all, W, H));
     assert!(failures.is_empty(), "{failures:?}");
 }

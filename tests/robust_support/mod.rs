@@ -157,16 +157,6 @@ fn tiny(dist: f64, seed: u64) -> Scene {
     }
 }
 
-/// Stress scenes on which the fast tracer does not yet match the reference: their
-/// comparison lives in `tests/robust_failing.rs` (see the diagnosis there).
-pub const FAILING_FAST_VS_REFERENCE: &[&str] = &[
-    "ground-1e5",
-    "ground-1e6",
-    "hw3-translated-1e4",
-    "tiny-far",
-    "facing-mirrors",
-];
-
 /// Every stress scene of issue 4, in the order of the report table.
 pub fn stress_scenes() -> Vec<Stress> {
     let mut out = Vec::new();
@@ -482,7 +472,7 @@ pub fn query(
     from: Option<(u32, whitted::model::Side)>,
 ) -> whitted::accel::Query {
     whitted::accel::Query {
-        origin: origin.as_vec3(),
+        origin,
         dir: dir.as_vec3().normalize(),
         from,
     }
@@ -491,7 +481,7 @@ pub fn query(
 /// The ray the fast path actually traces for a query: its origin and direction in
 /// `f64`, the direction normalised in `f64`.
 pub fn query_ray(q: &whitted::accel::Query) -> (DVec3, DVec3) {
-    (q.origin.as_dvec3(), q.dir.as_dvec3().normalize())
+    (q.origin, q.dir.as_dvec3().normalize())
 }
 
 /// Independent `f64` ray/sphere roots (unit `d`): `(near, far)`, written here rather
