@@ -519,3 +519,35 @@ fn an_interrupted_render_leaves_no_file() {
     assert!(stderr.contains("interrupted"), "{stderr}");
     assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
 }
+
+/// A giant image from the command line or from the file is refused before anything is
+/// allocated (65536² pixels of 12 bytes would be 51 GB: an attempt would abort, not
+/// print one line and exit 1).
+#[test]
+fn giant_images_are_refused_by_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("giant.toml");
+    std::fs::write(&scene, "[image]\nwidth = 65536\nheight = 65536\n").unwrap();
+    let out_file = dir.path().join("out.png");
+    let runs: [Vec<&std::ffi::OsStr>; 2] = [
+        ["render", "--width", "65536", "--height", "65536", "-o"]
+            .iter()
+            .map(std::ffi::OsStr::new)
+            .chain([out_file.as_os_str()])
+            .collect(),
+        ["render"]
+            .iter()
+            .map(std::ffi::OsStr::new)
+            .chain([scene.as_os_str(), "-o".as_ref(), out_file.as_os_str()])
+            .collect(),
+    ];
+    for args in runs {
+        let out = whitted().args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        println!("{args:?}: {:?} {stderr:?}", out.status.code());
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains("268435456 pixels"), "{stderr}");
+    }
+    assert!(!out_file.exists());
+}

@@ -448,9 +448,7 @@ fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
             }
             image.seed = n as u64;
         }
-        image
-            .check()
-            .map_err(|m| at.at(spanned.span(), format!("image: {m}")))?;
+        image.check().map_err(|m| at.at(spanned.span(), m))?;
     }
 
     let mut sky = Sky::default();
