@@ -226,13 +226,48 @@ fn the_loader_never_panics_and_every_error_is_one_located_line() {
             |(k, edits)| check_input(&mutate(&bases[k], &edits), &stats),
         )
         .unwrap_or_else(|e| panic!("{e}"));
+    // 4. A scene of 1300 spheres (three batches of the streamed parser), mutated: the
+    //    two paths agree on accepting, and on a bad value give the very same message.
+    let mut many = scene::hw3_scene(scene::HW3_DEFAULT_SEED);
+    let balls = many.spheres.clone();
+    for k in 0..24 {
+        many.spheres.extend(balls.iter().map(|b| {
+            let mut b = *b;
+            b.center.x += 4.0 * f64::from(k);
+            b
+        }));
+    }
+    let many = scene::to_toml(&many);
+    let same_error = RefCell::new((0u64, 0u64));
+    runner(300)
+        .run(&prop::collection::vec(mutation(), 1..3), |edits| {
+            let text = mutate(&many, &edits);
+            check_input(&text, &stats)?;
+            if let (Err(a), Err(b)) = (
+                Scene::from_toml_str(&text, PATH),
+                Scene::from_toml_str_whole(&text, PATH),
+            ) {
+                let mut n = same_error.borrow_mut();
+                n.0 += 1;
+                n.1 += u64::from(a == b);
+                // When the text parses, both report the first bad value (a syntax error
+                // later in the file may instead be what the whole-document parse sees).
+                if a.message.starts_with("sphere ") && b.message.starts_with("sphere ") {
+                    prop_assert_eq!(a, b);
+                }
+            }
+            Ok(())
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+    let (errors, same) = same_error.into_inner();
+    println!("1300-sphere scene mutated: {errors} errors, {same} identical from both paths");
     let s = stats.into_inner();
     println!(
         "loader fuzz: {} inputs, {} accepted (rendered 4x3 with both tracers), {} rejected \
          ({} with line:column, the rest with the file name only)",
         s.inputs, s.accepted, s.rejected, s.with_line_col
     );
-    assert!(s.inputs >= 28_000);
+    assert!(s.inputs >= 28_300);
     assert!(
         s.accepted > 100 && s.rejected > 1000,
         "both outcomes exercised: {s:?}"

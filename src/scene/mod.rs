@@ -32,7 +32,7 @@ pub mod limits {
     pub const MAX_FILE_BYTES: u64 = 1 << 26;
     /// Scene text parsed as one TOML document at most (the `toml` tree takes 35-65
     /// times the text); larger files must end in a run of `[[sphere]]` tables, which is
-    /// parsed one table at a time.
+    /// parsed a batch of tables at a time.
     pub const MAX_WHOLE_PARSE_BYTES: u64 = 1 << 24;
 }
 
