@@ -4,11 +4,13 @@
 
 mod hw3;
 mod load;
+mod many;
 mod write;
 
 use glam::DVec3;
 
 pub use hw3::{hw3_scene, hw3_toml, HW3_DEFAULT_SEED};
+pub use many::many_scene;
 pub use write::to_toml;
 
 /// The assignment's vertical field of view, `2·atan(2.25)` in degrees (≈ 132.075°):
