@@ -17,7 +17,7 @@ use super::*;
 /// What the fast path's answer is compared with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Truth {
-    /// The ray the query holds (`f32` origin and direction), computed in `f64`: the
+    /// The ray the query holds (its `f32` direction promoted), computed in `f64`: the
     /// error of the intersection maths alone.
     QueryRay,
     /// The `f64` ray before it was rounded into the query: the error a user sees.
@@ -82,7 +82,7 @@ pub fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
         s.spheres += 1;
         let primary = query(eye, aim - eye, None);
         let Some(hit) = set.closest(&primary) else {
-            // The f32 eye or direction can miss a ball that is tiny next to its
+            // The f32 direction can miss a ball that is tiny next to its
             // coordinates; counted, and nothing to spawn from.
             s.primary_misses += 1;
             return Ok(());
@@ -134,7 +134,7 @@ pub fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
                         c.length()
                     );
                 }
-                // The rounded origin fell outside and its line misses: so does f64.
+                // A grazing line that misses at f64 precision: so does the fast path.
                 (None, None) if truth == Truth::QueryRay => {}
                 (got, want) => {
                     s.inward_misses += 1;

@@ -463,9 +463,9 @@ pub const SCENE_TABLE_HEADER: &str =
 pub const TRANSFORM_TABLE_HEADER: &str =
     "transform                tracer        off>1     off % max diff  NaN/Inf";
 
-/// A fast-path query from an `f64` spawn point (rounded as `accel::Query` stores it)
-/// and an `f64` direction (rounded to `f32`, renormalised in `f32`): the one place to
-/// change if the query's types change.
+/// A fast-path query from an `f64` spawn point and an `f64` direction rounded to `f32`
+/// and renormalised in `f32`, as the fast tracer makes them: the one place to change
+/// if the query's types change.
 pub fn query(
     origin: DVec3,
     dir: DVec3,
