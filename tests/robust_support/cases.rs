@@ -82,8 +82,8 @@ pub fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
         s.spheres += 1;
         let primary = query(eye, aim - eye, None);
         let Some(hit) = set.closest(&primary) else {
-            // The f32 direction can miss a ball that is tiny next to its
-            // coordinates; counted, and nothing to spawn from.
+            // The f32 direction can miss a ball that is tiny next to its distance;
+            // counted, and nothing to spawn from.
             s.primary_misses += 1;
             return Ok(());
         };

@@ -241,14 +241,19 @@ pub fn stress_scenes() -> Vec<Stress> {
                 vfov: 70.0,
             });
             s.image.max_depth = 64;
+            // Between the mirrors (the default light would sit inside the left one).
+            s.lights = vec![Light {
+                position: DVec3::new(0.0, 5.0, 0.0),
+                intensity: DVec3::ONE,
+            }];
             s
         },
     );
     push(
         "resting-grazing",
         "Balls resting exactly on the ground (touching), balls interpenetrating each other \
-         and the ground, lit by a light 0.2 above the ground's top 50 units away: shadow \
-         rays graze the ground and start next to other surfaces.",
+         and the ground, lit by a light 4 degrees above the horizon: long shadows, shadow \
+         rays that graze the ground and start next to other surfaces.",
         {
             let mut s = hw3();
             s.spheres.truncate(1);
@@ -297,8 +302,9 @@ pub fn stress_scenes() -> Vec<Stress> {
                 0.0,
             ));
             s.lights = vec![Light {
-                position: DVec3::new(-50.0, -0.3, -2.0),
-                intensity: DVec3::ONE,
+                position: DVec3::new(-20.0, 1.0, -2.0),
+                // Bright, so that the ground it grazes is not black.
+                intensity: DVec3::splat(6.0),
             }];
             s
         },
