@@ -342,7 +342,7 @@ impl<'a> ReferenceTracer<'a> {
                     let (shadow, occluder) = self.shadow(&spawn(l, !front), dist);
                     let term = model::diffuse(s.color, light.intensity, cos, shadow);
                     rec.shadow(index, occluder, shadow, term, local_mix);
-                    local = local + term;
+                    local += term;
                 }
             }
         }

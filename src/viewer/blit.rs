@@ -35,7 +35,7 @@ pub fn parse_choice(value: Option<&str>) -> Result<Choice, String> {
 
 pub enum Blitter {
     Pixels {
-        pixels: Pixels<'static>,
+        pixels: Box<Pixels<'static>>,
         buffer: (u32, u32),
     },
     Soft {
@@ -66,7 +66,7 @@ impl Blitter {
             .build()
             .map_err(|e| format!("pixels cannot draw in the window: {e}"))?;
         Ok(Blitter::Pixels {
-            pixels,
+            pixels: Box::new(pixels),
             buffer: (w.max(1), h.max(1)),
         })
     }

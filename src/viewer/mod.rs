@@ -96,6 +96,12 @@ struct App {
     numbering: save::Numbering,
     saves: Vec<JoinHandle<()>>,
     first_frame_reported: bool,
+    /// The camera changed while the current view had nothing on screen yet: render
+    /// it once that view shows its first (preview) frame. Without this, a drag that
+    /// moves faster than a preview renders would cancel every view before it shows.
+    pending: bool,
+    /// Pixel samples per second of the last pass, to size the next preview.
+    speed: f64,
     error: Option<anyhow::Error>,
 }
 
@@ -134,6 +140,8 @@ impl App {
             numbering: save::Numbering::default(),
             saves: Vec::new(),
             first_frame_reported: false,
+            pending: false,
+            speed: f64::NAN,
             error: None,
         }
     }
@@ -162,13 +170,15 @@ impl App {
             return;
         }
         self.generation += 1;
+        self.pending = false;
         let mut scene = (*self.scene).clone();
         scene.camera = Some(self.camera.spec(&self.scene, w, h));
         self.job_scene = Arc::new(scene);
         self.job_size = (w, h);
         self.progress = Progress::Rendering;
+        let factor = schedule::preview_factor(w, h, self.speed);
         self.worker
-            .submit(self.generation, Arc::clone(&self.job_scene), w, h);
+            .submit(self.generation, Arc::clone(&self.job_scene), (w, h), factor);
         self.update_title();
     }
 
@@ -182,7 +192,11 @@ impl App {
     fn camera_action(&mut self, action: Action) {
         let (w, h) = self.job_size;
         if w > 0 && self.camera.apply(&self.scene, w, h, action) {
-            self.submit();
+            if self.progress == Progress::Rendering {
+                self.pending = true;
+            } else {
+                self.submit();
+            }
         }
     }
 
@@ -201,11 +215,9 @@ impl App {
             Key::Character(c) => match c.to_ascii_lowercase().as_str() {
                 "q" => event_loop.exit(),
                 "s" if !event.repeat => self.save(),
-                "r" => {
-                    if self.camera.is_edited() {
-                        self.camera.reset();
-                        self.submit();
-                    }
+                "r" if self.camera.is_edited() => {
+                    self.camera.reset();
+                    self.submit();
                 }
                 "h" => println!("{}", status::HELP),
                 _ => {}
@@ -259,6 +271,9 @@ impl App {
         if shown.generation != self.generation {
             return; // a stale pass of a cancelled view
         }
+        if shown.pass_seconds > 0.0 {
+            self.speed = shown.pass_pixels as f64 / shown.pass_seconds;
+        }
         self.progress = if shown.preview {
             Progress::Preview {
                 seconds: shown.pass_seconds,
@@ -274,6 +289,9 @@ impl App {
         self.fresh = true;
         if let Some(window) = &self.window {
             window.request_redraw();
+        }
+        if self.pending {
+            self.submit();
         }
     }
 
@@ -307,11 +325,12 @@ impl App {
         };
         let kind = if shown.preview { "preview" } else { "samples" };
         eprintln!(
-            "stats: view {} {} {}x{} spp {}/{} render_ms {:.2} blit_ms {:.2} since_view_ms {:.2} since_start_ms {:.2}",
+            "stats: view {} {} {}x{} pass_pixels {} spp {}/{} render_ms {:.2} blit_ms {:.2} since_view_ms {:.2} since_start_ms {:.2}",
             shown.generation,
             kind,
             shown.frame.width,
             shown.frame.height,
+            shown.pass_pixels,
             shown.samples,
             shown.target,
             shown.pass_seconds * 1e3,
@@ -368,6 +387,9 @@ impl ApplicationHandler<Report> for App {
                     eprintln!("whitted: cannot render this view: {message}");
                     self.progress = Progress::Failed;
                     self.update_title();
+                    if self.pending {
+                        self.submit();
+                    }
                 }
             }
         }

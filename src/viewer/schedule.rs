@@ -6,8 +6,13 @@
 
 use std::ops::Range;
 
-/// The preview has 1/`PREVIEW_FACTOR` of the width and of the height.
-pub const PREVIEW_FACTOR: u32 = 4;
+/// The preview has 1/factor of the width and of the height: this at first, then
+/// whatever [`preview_factor`] picks from the speed measured so far.
+pub const START_PREVIEW_FACTOR: u32 = 4;
+const MIN_PREVIEW_FACTOR: u32 = 2;
+const MAX_PREVIEW_FACTOR: u32 = 16;
+/// The time a preview should take, so that a drag shows about 30 views a second.
+const PREVIEW_SECONDS: f64 = 1.0 / 30.0;
 /// No preview for images with fewer pixels than this: the full frame is fast anyway.
 const PREVIEW_MIN_PIXELS: u64 = 32 * 32 * 16;
 /// The largest batch of samples between two displayed frames.
@@ -15,20 +20,40 @@ const MAX_BATCH: u32 = 8;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Pass {
-    /// The whole image at `width`×`height` (the reduced size), one sample per pixel,
-    /// shown scaled up.
-    Preview { width: u32, height: u32 },
+    /// The whole image at `width`×`height` (1/`factor` of the size), one sample per
+    /// pixel, shown scaled up.
+    Preview {
+        width: u32,
+        height: u32,
+        factor: u32,
+    },
     /// These samples of every pixel at full resolution.
     Samples(Range<u32>),
 }
 
-/// The passes for a `width`×`height` view with `spp` samples per pixel.
-pub fn plan(width: u32, height: u32, spp: u32) -> Vec<Pass> {
+/// The preview factor for a `width`×`height` view that renders a preview within
+/// [`PREVIEW_SECONDS`] at `pixels_per_second` (measured on earlier previews).
+pub fn preview_factor(width: u32, height: u32, pixels_per_second: f64) -> u32 {
+    if !(pixels_per_second.is_finite() && pixels_per_second > 0.0) {
+        return START_PREVIEW_FACTOR;
+    }
+    let budget = (pixels_per_second * PREVIEW_SECONDS).max(1.0);
+    let factor = (f64::from(width) * f64::from(height) / budget)
+        .sqrt()
+        .ceil();
+    (factor as u32).clamp(MIN_PREVIEW_FACTOR, MAX_PREVIEW_FACTOR)
+}
+
+/// The passes for a `width`×`height` view with `spp` samples per pixel, starting
+/// with a preview at 1/`factor` of the size.
+pub fn plan(width: u32, height: u32, spp: u32, factor: u32) -> Vec<Pass> {
     let mut passes = Vec::new();
+    let factor = factor.max(MIN_PREVIEW_FACTOR);
     if u64::from(width) * u64::from(height) >= PREVIEW_MIN_PIXELS {
         passes.push(Pass::Preview {
-            width: width.div_ceil(PREVIEW_FACTOR),
-            height: height.div_ceil(PREVIEW_FACTOR),
+            width: width.div_ceil(factor),
+            height: height.div_ceil(factor),
+            factor,
         });
     }
     let spp = spp.max(1);
@@ -64,36 +89,38 @@ mod tests {
 
     #[test]
     fn large_images_start_with_a_quarter_size_preview() {
-        let passes = plan(1280, 720, 1);
+        let passes = plan(1280, 720, 1, 4);
         assert_eq!(
             passes,
             vec![
                 Pass::Preview {
                     width: 320,
-                    height: 180
+                    height: 180,
+                    factor: 4
                 },
                 Pass::Samples(0..1)
             ]
         );
         // Odd sizes round up so that every full pixel has a preview pixel.
         assert_eq!(
-            plan(321, 181, 1)[0],
+            plan(321, 181, 1, 4)[0],
             Pass::Preview {
                 width: 81,
-                height: 46
+                height: 46,
+                factor: 4
             }
         );
     }
 
     #[test]
     fn tiny_images_skip_the_preview() {
-        assert_eq!(plan(64, 64, 1), vec![Pass::Samples(0..1)]);
+        assert_eq!(plan(64, 64, 1, 4), vec![Pass::Samples(0..1)]);
     }
 
     #[test]
     fn batches_cover_all_samples_in_order() {
         for spp in [1, 2, 3, 5, 16, 17, 100, 1000] {
-            let ranges = samples(&plan(320, 180, spp));
+            let ranges = samples(&plan(320, 180, spp, 4));
             assert_eq!(ranges[0], 0..1, "spp {spp}: one sample first");
             let mut next = 0;
             for r in &ranges {
@@ -104,9 +131,22 @@ mod tests {
             assert_eq!(next, spp);
         }
         assert_eq!(
-            samples(&plan(320, 180, 16)),
+            samples(&plan(320, 180, 16, 4)),
             vec![0..1, 1..2, 2..4, 4..8, 8..16]
         );
+    }
+
+    #[test]
+    fn the_preview_factor_fits_the_time_budget() {
+        // 1.2 Mpixel/s and 1/30 s: 40 000 pixels, so 1280×720 needs 1/5 per side.
+        assert_eq!(preview_factor(1280, 720, 1.2e6), 5);
+        let (w, h) = (1280 / 5, 720 / 5);
+        assert!(f64::from(w * h) <= 1.2e6 / 30.0);
+        // Clamped at both ends, and a sane start without a measurement.
+        assert_eq!(preview_factor(1280, 720, 1e12), MIN_PREVIEW_FACTOR);
+        assert_eq!(preview_factor(1280, 720, 1.0), MAX_PREVIEW_FACTOR);
+        assert_eq!(preview_factor(1280, 720, f64::NAN), START_PREVIEW_FACTOR);
+        assert_eq!(preview_factor(1280, 720, 0.0), START_PREVIEW_FACTOR);
     }
 
     #[test]

@@ -15,7 +15,7 @@ use crate::render::{self, Frame, RenderControl, RenderError, RenderOptions};
 use crate::scene::Scene;
 
 use super::buffer::{to_rgba_top_down, upscale};
-use super::schedule::{plan, Pass, PREVIEW_FACTOR};
+use super::schedule::{plan, Pass};
 
 /// One view to render: the scene (its camera is the view's), at this size.
 pub struct Job {
@@ -23,6 +23,8 @@ pub struct Job {
     pub scene: Arc<Scene>,
     pub width: u32,
     pub height: u32,
+    /// The preview's size is 1/`preview_factor` of the view's.
+    pub preview_factor: u32,
     control: Arc<RenderControl>,
     submitted: Instant,
 }
@@ -41,6 +43,8 @@ pub struct Shown {
     /// The target samples per pixel.
     pub target: u32,
     pub preview: bool,
+    /// The number of pixels rendered in this pass (the preview's are fewer).
+    pub pass_pixels: u64,
     /// The last pass: the image is complete.
     pub done: bool,
     /// Time this pass took.
@@ -77,7 +81,13 @@ impl Worker {
     }
 
     /// Cancels the running job and queues this one.
-    pub fn submit(&mut self, generation: u64, scene: Arc<Scene>, width: u32, height: u32) {
+    pub fn submit(
+        &mut self,
+        generation: u64,
+        scene: Arc<Scene>,
+        (width, height): (u32, u32),
+        preview_factor: u32,
+    ) {
         self.cancel();
         let control = Arc::new(RenderControl::default());
         self.current = Some(Arc::clone(&control));
@@ -86,6 +96,7 @@ impl Worker {
             scene,
             width,
             height,
+            preview_factor,
             control,
             submitted: Instant::now(),
         };
@@ -142,15 +153,19 @@ pub fn run(job: &Job, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
     let target = opts.image.spp;
     let tracer = render::make_tracer(scene, &opts)?;
     let mut sums = vec![Vec3::ZERO; w as usize * h as usize];
-    let passes = plan(w, h, target);
+    let passes = plan(w, h, target, job.preview_factor);
     let last = passes.len() - 1;
     for (index, pass) in passes.into_iter().enumerate() {
         if control.is_cancelled() {
             return Err(RenderError::Cancelled);
         }
         let start = Instant::now();
-        let (frame, samples, preview) = match pass {
-            Pass::Preview { width, height } => {
+        let (frame, samples, preview, pass_pixels) = match pass {
+            Pass::Preview {
+                width,
+                height,
+                factor,
+            } => {
                 let mut small = opts.clone();
                 small.image.width = width;
                 small.image.height = height;
@@ -159,12 +174,14 @@ pub fn run(job: &Job, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
                 let mut preview_sums = vec![Vec3::ZERO; width as usize * height as usize];
                 render::accumulate(tracer.as_ref(), &small, 0..1, &mut preview_sums, control)?;
                 let preview = render::resolve(&preview_sums, 1, width, height);
-                (upscale(&preview, PREVIEW_FACTOR, w, h), 0, true)
+                let pixels = u64::from(width) * u64::from(height);
+                (upscale(&preview, factor, w, h), 0, true, pixels)
             }
             Pass::Samples(range) => {
                 let end = range.end;
+                let pixels = u64::from(w) * u64::from(h) * range.len() as u64;
                 render::accumulate(tracer.as_ref(), &opts, range, &mut sums, control)?;
-                (render::resolve(&sums, end, w, h), end, false)
+                (render::resolve(&sums, end, w, h), end, false, pixels)
             }
         };
         let rgba = to_rgba_top_down(&frame);
@@ -175,6 +192,7 @@ pub fn run(job: &Job, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
             samples,
             target,
             preview,
+            pass_pixels,
             done: index == last,
             pass_seconds: start.elapsed().as_secs_f64(),
             since_submit: job.submitted.elapsed().as_secs_f64(),
@@ -204,6 +222,7 @@ mod tests {
             scene: Arc::new(worker_scene),
             width: w,
             height: h,
+            preview_factor: 4,
             control: Arc::new(RenderControl::default()),
             submitted: Instant::now(),
         };
@@ -244,10 +263,10 @@ mod tests {
         });
         let mut big = hw3_scene(HW3_DEFAULT_SEED);
         big.image.spp = 64;
-        worker.submit(1, Arc::new(big), 640, 360);
+        worker.submit(1, Arc::new(big), (640, 360), 4);
         let mut small = hw3_scene(HW3_DEFAULT_SEED);
         small.image.spp = 1;
-        worker.submit(2, Arc::new(small), 32, 18);
+        worker.submit(2, Arc::new(small), (32, 18), 4);
         // The small job completes; the big one never reaches its last pass.
         loop {
             match rx.recv_timeout(Duration::from_secs(60)).expect("a report") {
@@ -268,7 +287,7 @@ mod tests {
         let mut worker = Worker::spawn(move |r| {
             let _ = tx.send(r);
         });
-        worker.submit(3, Arc::new(hw3_scene(HW3_DEFAULT_SEED)), 0, 10);
+        worker.submit(3, Arc::new(hw3_scene(HW3_DEFAULT_SEED)), (0, 10), 4);
         match rx.recv_timeout(Duration::from_secs(60)).expect("a report") {
             Report::Failed { generation, .. } => assert_eq!(generation, 3),
             Report::Frame(_) => panic!("a 0-wide frame rendered"),
