@@ -290,6 +290,15 @@ fn screenshot_matching(x: &XServer, window: &str, dir: &Path, expected: &RgbImag
 }
 
 fn start_viewer(x: &XServer, dir: &Path, scene: &Path, blit: &str) -> (Viewer, String) {
+    start_viewer_with(x, dir, scene, &[("WHITTED_BLIT", blit)])
+}
+
+fn start_viewer_with(
+    x: &XServer,
+    dir: &Path,
+    scene: &Path,
+    env: &[(&str, &str)],
+) -> (Viewer, String) {
     let stdout = dir.join("viewer.out");
     let stderr = dir.join("viewer.err");
     let child = x
@@ -297,7 +306,7 @@ fn start_viewer(x: &XServer, dir: &Path, scene: &Path, blit: &str) -> (Viewer, S
         .arg("view")
         .arg(scene)
         .current_dir(dir)
-        .env("WHITTED_BLIT", blit)
+        .envs(env.iter().copied())
         .env("WHITTED_STATS", "1")
         .stdin(Stdio::null())
         .stdout(fs::File::create(&stdout).unwrap())
@@ -457,6 +466,38 @@ fn samples_accumulate_to_the_render_at_the_target_spp() {
 }
 
 #[test]
+fn without_a_gpu_adapter_it_falls_back_to_softbuffer() {
+    if !x_tools_or_skip("softbuffer fallback test") {
+        return;
+    }
+    let x = XServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let scene = small_scene(dir, 1);
+    let expected = headless(dir, &scene, &[], "render.png");
+    // Vulkan only, and no Vulkan driver: wgpu finds no adapter.
+    let no_gpu = [
+        ("WHITTED_BLIT", ""),
+        ("WGPU_BACKEND", "vulkan"),
+        ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+        ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+    ];
+    let (mut viewer, window) = start_viewer_with(&x, dir, &scene, &no_gpu);
+    x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
+    let stderr = viewer.stderr();
+    assert!(
+        stderr.contains("drawing with softbuffer instead")
+            && stderr.contains("stats: blitter softbuffer\n"),
+        "{stderr}"
+    );
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(diff, 0, "{diff} pixels differ from `whitted render`");
+    x.key(&window, "q");
+    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
+    assert!(status.success());
+}
+
+#[test]
 fn without_a_display_it_says_so_and_exits_1() {
     let out = Command::new(BIN)
         .env_remove("DISPLAY")
@@ -480,5 +521,9 @@ fn without_a_display_it_says_so_and_exits_1() {
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
-    assert!(stderr.contains("whitted render"), "{stderr}");
+    assert!(
+        stderr.contains("cannot open the display") && stderr.contains("whitted render"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains(".rs:"), "no source locations: {stderr}");
 }

@@ -55,13 +55,22 @@ pub fn run(scene: Scene) -> anyhow::Result<()> {
     }
     let event_loop = EventLoop::<Report>::with_user_event()
         .build()
-        .map_err(|e| anyhow!("cannot open the display ({e}); {hint}"))?;
+        .map_err(|e| anyhow!("cannot open the display ({}); {hint}", winit_message(&e)))?;
     event_loop.set_control_flow(ControlFlow::Wait);
     let mut app = App::new(scene, event_loop.create_proxy(), choice, stats, started);
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
     app.finish()
+}
+
+/// winit's error without the source location it prefixes to OS errors.
+fn winit_message(e: &dyn std::fmt::Display) -> String {
+    let text = e.to_string();
+    match text.split_once(": ") {
+        Some((location, message)) if location.starts_with("os error at ") => message.into(),
+        _ => text,
+    }
 }
 
 struct Drag {
