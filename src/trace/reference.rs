@@ -392,7 +392,7 @@ impl<'a> ReferenceTracer<'a> {
         rec: &mut R,
     ) -> DVec3 {
         let c = &self.camera;
-        let dir = model::primary_direction(c.origin, c.lower_left, c.horizontal, c.vertical, s, t);
+        let dir = model::primary_direction(c.lower_left - c.origin, c.horizontal, c.vertical, s, t);
         let ray = Ray {
             origin: c.origin,
             dir,
