@@ -166,11 +166,12 @@ pub fn run(job: &Job, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
                 height,
                 factor,
             } => {
+                // The full-size tracer: its camera takes film positions in [0,1]², so
+                // fewer pixels give the same view, and nothing is compiled twice.
                 let mut small = opts.clone();
                 small.image.width = width;
                 small.image.height = height;
                 small.image.spp = 1;
-                let tracer = render::make_tracer(scene, &small)?;
                 let mut preview_sums = vec![Vec3::ZERO; width as usize * height as usize];
                 render::accumulate(tracer.as_ref(), &small, 0..1, &mut preview_sums, control)?;
                 let preview = render::resolve(&preview_sums, 1, width, height);
@@ -247,6 +248,11 @@ mod tests {
         opts.image.height = h;
         let (expected, _) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
         assert_eq!(*shown.last().unwrap().frame, expected);
+        // The preview is the same view at a quarter of the size, scaled up.
+        let mut small = opts.clone();
+        (small.image.width, small.image.height, small.image.spp) = (w / 4, h / 4, 1);
+        let (preview, _) = render::render(&scene, &small, &RenderControl::default()).unwrap();
+        assert_eq!(*shown[0].frame, upscale(&preview, 4, w, h));
         // The 1-sample pass is the first sample of the 5-spp pattern.
         let tracer = render::make_tracer(&scene, &opts).unwrap();
         let mut sums = vec![Vec3::ZERO; (w * h) as usize];
