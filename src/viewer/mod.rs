@@ -105,10 +105,8 @@ struct App {
     numbering: save::Numbering,
     saves: Vec<JoinHandle<()>>,
     first_frame_reported: bool,
-    /// The camera changed while the current view had nothing on screen yet: render
-    /// it once that view shows its first (preview) frame. Without this, a drag that
-    /// moves faster than a preview renders would cancel every view before it shows.
-    pending: bool,
+    /// Holds camera changes while the current view has nothing on screen.
+    throttle: schedule::Throttle,
     /// Pixel samples per second of the last pass, to size the next preview.
     speed: f64,
     error: Option<anyhow::Error>,
@@ -149,7 +147,7 @@ impl App {
             numbering: save::Numbering::default(),
             saves: Vec::new(),
             first_frame_reported: false,
-            pending: false,
+            throttle: schedule::Throttle::default(),
             speed: f64::NAN,
             error: None,
         }
@@ -179,7 +177,7 @@ impl App {
             return;
         }
         self.generation += 1;
-        self.pending = false;
+        self.throttle.started();
         let mut scene = (*self.scene).clone();
         scene.camera = Some(self.camera.spec(&self.scene, w, h));
         self.job_scene = Arc::new(scene);
@@ -201,9 +199,7 @@ impl App {
     fn camera_action(&mut self, action: Action) {
         let (w, h) = self.job_size;
         if w > 0 && self.camera.apply(&self.scene, w, h, action) {
-            if self.progress == Progress::Rendering {
-                self.pending = true;
-            } else {
+            if self.throttle.changed() {
                 self.submit();
             }
         }
@@ -299,7 +295,7 @@ impl App {
         if let Some(window) = &self.window {
             window.request_redraw();
         }
-        if self.pending {
+        if self.throttle.shown() {
             self.submit();
         }
     }
@@ -396,7 +392,7 @@ impl ApplicationHandler<Report> for App {
                     eprintln!("whitted: cannot render this view: {message}");
                     self.progress = Progress::Failed;
                     self.update_title();
-                    if self.pending {
+                    if self.throttle.shown() {
                         self.submit();
                     }
                 }

@@ -73,6 +73,43 @@ pub fn preview_source(i: u32, j: u32, factor: u32) -> (u32, u32) {
     (i / factor, j / factor)
 }
 
+/// When to start rendering a changed camera. A drag moves the camera more often than
+/// a preview renders; starting a view at every move would cancel each one before it
+/// shows anything. So a change waits while the current view has nothing on screen
+/// yet, and the latest camera starts as soon as it has (latest wins, one in flight).
+#[derive(Debug, Default)]
+pub struct Throttle {
+    /// The current view has shown a frame (or failed).
+    shown: bool,
+    /// A camera change waits.
+    pending: bool,
+}
+
+impl Throttle {
+    /// A view was submitted.
+    pub fn started(&mut self) {
+        self.shown = false;
+        self.pending = false;
+    }
+
+    /// The camera changed: true if it should be rendered now, else it waits.
+    pub fn changed(&mut self) -> bool {
+        if self.shown {
+            true
+        } else {
+            self.pending = true;
+            false
+        }
+    }
+
+    /// The current view showed a frame or failed: true if a waiting change should be
+    /// rendered now.
+    pub fn shown(&mut self) -> bool {
+        self.shown = true;
+        std::mem::take(&mut self.pending)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -147,6 +184,24 @@ mod tests {
         assert_eq!(preview_factor(1280, 720, 1.0), MAX_PREVIEW_FACTOR);
         assert_eq!(preview_factor(1280, 720, f64::NAN), START_PREVIEW_FACTOR);
         assert_eq!(preview_factor(1280, 720, 0.0), START_PREVIEW_FACTOR);
+    }
+
+    #[test]
+    fn camera_changes_wait_for_the_current_view_to_show() {
+        let mut t = Throttle::default();
+        t.started();
+        // Moves while nothing is on screen wait, and collapse into one.
+        assert!(!t.changed());
+        assert!(!t.changed());
+        assert!(t.shown(), "the waiting change starts once a frame shows");
+        t.started();
+        assert!(!t.shown(), "nothing waits any more");
+        // Once the view shows, changes start at once (cancelling its refinement).
+        assert!(t.changed());
+        t.started();
+        assert!(!t.changed());
+        t.started(); // e.g. a resize started a view anyway: the wait is over
+        assert!(!t.shown());
     }
 
     #[test]
