@@ -198,10 +198,8 @@ impl App {
 
     fn camera_action(&mut self, action: Action) {
         let (w, h) = self.job_size;
-        if w > 0 && self.camera.apply(&self.scene, w, h, action) {
-            if self.throttle.changed() {
-                self.submit();
-            }
+        if w > 0 && self.camera.apply(&self.scene, w, h, action) && self.throttle.changed() {
+            self.submit();
         }
     }
 
