@@ -371,12 +371,13 @@ impl ApplicationHandler<Report> for App {
         } else {
             self.size
         };
+        self.window = Some(Arc::clone(&window));
+        // Render while the blitter starts up (wgpu takes a while to find its adapter).
+        self.submit();
         match Blitter::new(&window, surface, self.choice) {
             Ok(blitter) => self.blitter = Some(blitter),
-            Err(e) => return self.fail(event_loop, anyhow!(e)),
+            Err(e) => self.fail(event_loop, anyhow!(e)),
         }
-        self.window = Some(window);
-        self.submit();
     }
 
     fn user_event(&mut self, _event_loop: &ActiveEventLoop, report: Report) {
