@@ -410,6 +410,22 @@ fn session(blit: &str) {
     let diff = screenshot_matching(&x, &window, dir, &expected);
     assert_eq!(diff, 0, "{blit}: after R, {diff} pixels differ");
 
+    // The arrows and PageUp move the camera; R again brings it back; H lists keys.
+    for key in ["Up", "Left", "Prior"] {
+        x.key(&window, key);
+    }
+    wait_for("the moved view", || {
+        viewer.assert_running();
+        let done = x.title(&window).ends_with("- done");
+        let moved = x.screenshot(&window, dir, "moved.png");
+        (done && differing(&moved, &expected) > 1000).then_some(())
+    });
+    x.key(&window, "r");
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(diff, 0, "{blit}: after moving and R, {diff} pixels differ");
+    x.key(&window, "h");
+    viewer.wait_stdout("PageUp, PageDown");
+
     // Resizing re-renders at the new size, with the same vertical field of view as a
     // headless render at that size.
     x.xdotool(&["windowsize", &window, "240", "200"]);
