@@ -21,7 +21,10 @@ pub struct Timing {
 impl Timing {
     /// The fastest run (what `run.sh` keeps for the peers: "best of N").
     pub fn best_render_seconds(&self) -> f64 {
-        self.all_render_seconds.iter().copied().fold(f64::INFINITY, f64::min)
+        self.all_render_seconds
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min)
     }
 
     pub fn mrays_per_second(&self) -> f64 {

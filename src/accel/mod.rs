@@ -254,7 +254,9 @@ impl Spheres {
         if best.k == usize::MAX {
             return None;
         }
-        let normal = best.normal.normalize();
+        // (l ∓ √disc·d)/r is a unit vector up to rounding (|l|² + disc = r², l ⊥ d):
+        // no need to normalise again.
+        let normal = best.normal;
         Some(Hit {
             sphere: best.k as u32,
             point: self.center[best.k] + normal * self.radius[best.k],
