@@ -13,6 +13,7 @@ pub mod accel;
 pub mod camera;
 pub mod image_io;
 pub mod model;
+pub mod quality;
 pub mod render;
 pub mod sampling;
 pub mod scene;
