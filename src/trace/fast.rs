@@ -52,7 +52,14 @@ struct Skipped {
 impl FastTracer {
     pub fn new(scene: &Scene, camera: &Camera, max_depth: u32) -> Self {
         FastTracer {
-            spheres: Spheres::new(&scene.spheres),
+            spheres: Spheres::new(&scene.spheres).with_grids(
+                camera.origin.as_vec3().as_dvec3(),
+                &scene
+                    .lights
+                    .iter()
+                    .map(|l| l.position.as_vec3().as_dvec3())
+                    .collect::<Vec<_>>(),
+            ),
             materials: scene
                 .spheres
                 .iter()
@@ -120,7 +127,12 @@ impl FastTracer {
         } else {
             counts.secondary += 1;
         }
-        let Some(hit) = self.spheres.closest(ray) else {
+        let hit = if depth == 0 {
+            self.spheres.closest_primary(ray)
+        } else {
+            self.spheres.closest(ray)
+        };
+        let Some(hit) = hit else {
             return model::sky(ray.dir, self.sky_down, self.sky_up);
         };
         let m = &self.materials[hit.sphere as usize];
@@ -137,7 +149,7 @@ impl FastTracer {
         let mut local = Vec3::ZERO;
         let w_local = weight * (1.0 - m.w_t) * (1.0 - m.w_r);
         if m.branches.local && self.keep(w_local, skipped) {
-            for light in &self.lights {
+            for (index, light) in self.lights.iter().enumerate() {
                 // The light direction from the f64 point: the f32 one may sit off the sphere.
                 let to_light = light.position.as_dvec3() - hit.point;
                 let dist = to_light.length();
@@ -145,7 +157,7 @@ impl FastTracer {
                 let cos = nf.dot(l);
                 if cos > 0.0 {
                     counts.shadow += 1;
-                    let shadow = self.spheres.shadow(&spawn(l, !front), dist);
+                    let shadow = self.spheres.shadow_to_light(&spawn(l, !front), dist, index);
                     local += model::diffuse(m.color, light.intensity, cos, shadow);
                 }
             }
