@@ -10,6 +10,7 @@
 #![forbid(unsafe_code)]
 
 pub mod accel;
+pub mod bench;
 pub mod camera;
 pub mod image_io;
 pub mod model;

@@ -1,0 +1,120 @@
+//! The trade-off study on its tiny grid: it runs, and its outputs are complete.
+
+use glam::Vec3;
+
+use whitted::bench::{self, BenchOptions, CSV_HEADER};
+use whitted::render::Frame;
+
+#[test]
+fn tiny_study_writes_a_complete_csv_table_and_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = BenchOptions {
+        out: dir.path().to_path_buf(),
+        width: 32,
+        height: 18,
+        runs: 5,
+        tiny: true,
+        threads: Some(2),
+        progress: false,
+    };
+    let rows = bench::run(&opts).unwrap();
+    let scenes = bench::study_scenes(true);
+    // Every setting on every scene, plus the reference preset row per scene.
+    assert_eq!(rows.len(), scenes.len() * (bench::grid(true).len() + 1));
+
+    let csv = std::fs::read_to_string(dir.path().join("bench.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header, CSV_HEADER.split(',').collect::<Vec<_>>());
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let body: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(body.len(), rows.len());
+    for row in &body {
+        assert_eq!(row.len(), header.len(), "{row:?}");
+        assert!(row.iter().all(|c| !c.trim().is_empty()), "empty cell in {row:?}");
+        assert_eq!(row[col("runs")].parse::<usize>().unwrap() >= 1, true);
+        let median: f64 = row[col("median_s")].parse().unwrap();
+        assert!(median > 0.0);
+        let rmse: f64 = row[col("rmse_levels")].parse().unwrap();
+        let flip: f64 = row[col("flip_mean")].parse().unwrap();
+        assert!(rmse >= 0.0 && (0.0..=1.0).contains(&flip));
+    }
+    for s in &scenes {
+        let these: Vec<&Vec<&str>> = body.iter().filter(|r| r[0] == s.name).collect();
+        assert!(these.iter().any(|r| r[col("pareto")] == "true"), "{}", s.name);
+        // The fastest setting is on the front by definition.
+        let fastest = these
+            .iter()
+            .min_by(|a, b| {
+                let t = |r: &Vec<&str>| r[col("median_s")].parse::<f64>().unwrap();
+                t(a).total_cmp(&t(b))
+            })
+            .unwrap();
+        assert_eq!(fastest[col("pareto")], "true");
+        let reference = these.iter().find(|r| r[col("preset")] == "reference").unwrap();
+        assert_eq!(reference[col("rmse_levels")], "0.0000");
+        // Timed settings ran the asked number of times.
+        assert!(these
+            .iter()
+            .filter(|r| r[col("preset")] != "reference")
+            .all(|r| r[col("runs")] == "5"));
+    }
+    // The cutoff setting reports a bound; the others none.
+    assert!(body
+        .iter()
+        .filter(|r| r[col("cutoff")] != "0")
+        .any(|r| r[col("cutoff_bound_levels")].parse::<f64>().unwrap() > 0.0));
+
+    let md = std::fs::read_to_string(dir.path().join("bench.md")).unwrap();
+    assert!(md.contains("## Presets") && md.contains("| hw3 | default |"));
+    let svg = std::fs::read_to_string(dir.path().join("bench.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("Pareto front"));
+
+    // A second run reuses the cached references and measures the same errors.
+    let again = bench::run(&opts).unwrap();
+    let errs = |rs: &[bench::Row]| rs.iter().map(|r| r.errors.rmse).collect::<Vec<_>>();
+    let first: Vec<f64> = errs(&rows)
+        .into_iter()
+        .zip(&rows)
+        .filter(|(_, r)| r.runs > 1)
+        .map(|(e, _)| e)
+        .collect();
+    let second: Vec<f64> = errs(&again)
+        .into_iter()
+        .zip(&again)
+        .filter(|(_, r)| r.runs > 1)
+        .map(|(e, _)| e)
+        .collect();
+    assert_eq!(first, second);
+}
+
+fn frame(pixels: Vec<Vec3>) -> Frame {
+    Frame {
+        width: pixels.len() as u32,
+        height: 1,
+        pixels,
+    }
+}
+
+#[test]
+fn errors_are_measured_in_displayed_levels() {
+    let reference = frame(vec![Vec3::splat(0.5); 4]);
+    let same = bench::compare(&reference, &reference);
+    assert_eq!(same.rmse, 0.0);
+    assert!(same.psnr.is_infinite());
+    assert_eq!((same.max, same.off_by_more_than_1, same.flip), (0, 0.0, 0.0));
+
+    // One channel of one pixel 10 levels off; another pixel above 1 (clamped: no error).
+    let mut pixels = vec![Vec3::splat(0.5); 4];
+    pixels[1].x += 10.0 / 255.0;
+    let mut reference = reference.clone();
+    reference.pixels[3] = Vec3::splat(1.0);
+    pixels[3] = Vec3::splat(3.0);
+    let e = bench::compare(&frame(pixels), &reference);
+    let rmse = (100.0f64 / 12.0).sqrt();
+    assert!((e.rmse - rmse).abs() < 1e-3, "{}", e.rmse);
+    assert!((e.psnr - 20.0 * (255.0 / rmse).log10()).abs() < 1e-3);
+    assert_eq!(e.max, 10);
+    assert_eq!(e.off_by_more_than_1, 0.25);
+    assert!(e.flip > 0.0);
+}
