@@ -18,6 +18,7 @@ pub mod quality;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod speed;
 pub mod trace;
 pub mod viewer;
 

@@ -158,7 +158,10 @@ impl Frame {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderStats {
     pub rays: RayCounts,
+    /// Wall time of the whole render, preparation included.
     pub seconds: f64,
+    /// Of which: compiling the scene for the tracer (acceleration structures).
+    pub build_seconds: f64,
 }
 
 impl RenderStats {
@@ -338,6 +341,7 @@ pub fn render_bounded(
     opts.check()?;
     let start = Instant::now();
     let tracer = make_tracer(scene, opts)?;
+    let build_seconds = start.elapsed().as_secs_f64();
     let area = opts.area();
     let spp = opts.image.spp;
     let (frame, cutoff_bound, refined, rays) = match opts.adaptive {
@@ -374,6 +378,7 @@ pub fn render_bounded(
         stats: RenderStats {
             rays,
             seconds: start.elapsed().as_secs_f64(),
+            build_seconds,
         },
     })
 }

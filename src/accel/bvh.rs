@@ -174,12 +174,39 @@ fn build_node(
         mid
     };
     let (left, right) = items.split_at_mut(mid);
-    build_node(boxes, centres, left, first, depth + 1, nodes);
-    let right_index = build_node(boxes, centres, right, first + mid as u32, depth + 1, nodes);
+    let right_index = if items_len_is_large(left.len() + right.len()) {
+        // Big subtrees build on two threads, into their own vectors, then splice.
+        let (mut l, mut r) = (Vec::new(), Vec::new());
+        rayon::join(
+            || build_node(boxes, centres, left, first, depth + 1, &mut l),
+            || build_node(boxes, centres, right, first + mid as u32, depth + 1, &mut r),
+        );
+        let base = nodes.len() as u32;
+        nodes.extend(l.into_iter().map(|n| offset(n, base)));
+        let right_base = nodes.len() as u32;
+        nodes.extend(r.into_iter().map(|n| offset(n, right_base)));
+        right_base
+    } else {
+        build_node(boxes, centres, left, first, depth + 1, nodes);
+        build_node(boxes, centres, right, first + mid as u32, depth + 1, nodes)
+    };
     nodes[me as usize].index = right_index;
     nodes[me as usize].count = 0;
     nodes[me as usize].axis = axis as u32;
     me
+}
+
+/// Subtrees this big are worth a thread of their own.
+fn items_len_is_large(n: usize) -> bool {
+    n >= 8192
+}
+
+/// A node of a subtree built at index 0, moved to start at `base`.
+fn offset(mut n: Node, base: u32) -> Node {
+    if n.count == 0 {
+        n.index += base; // inner: right-child index is relative to the subtree
+    }
+    n
 }
 
 /// The binned-SAH split `(axis, position)`, or `None` when a leaf is cheaper.

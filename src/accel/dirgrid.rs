@@ -10,7 +10,7 @@ use glam::{DVec3, Vec3};
 
 pub struct DirGrid {
     /// The point every ray of the grid passes through.
-    pub centre: Vec3,
+    pub centre: DVec3,
     /// Cells per face side.
     n: u32,
     /// Cell `c` lists `items[offsets[c]..offsets[c+1]]`.
@@ -30,81 +30,92 @@ impl DirGrid {
     /// Builds the grid around `centre` for spheres `(centre, radius)`.
     pub fn build(centre: DVec3, spheres: &[(DVec3, f64)], n: u32) -> DirGrid {
         let faces = 6 * (n as usize) * (n as usize);
+        // Each sphere's nearest distance from the centre, rounded down so that the
+        // early exit of queries stays conservative.
+        let near_of: Vec<f32> = spheres
+            .iter()
+            .map(|&(c, r)| {
+                let dist = (c - centre).length();
+                let d = (dist - r) - 1e-6 * (dist + r + centre.abs().max_element());
+                let f = d as f32;
+                if f64::from(f) > d {
+                    f.next_down()
+                } else {
+                    f
+                }
+            })
+            .collect();
+        // Visit spheres nearest first: the stable fill below then leaves every cell's
+        // list sorted, so closest-hit queries can stop early.
+        let mut order: Vec<u32> = (0..spheres.len() as u32).collect();
+        order.sort_unstable_by(|&a, &b| near_of[a as usize].total_cmp(&near_of[b as usize]));
+
+        let cones = CellCones::shared(n);
         let mut always = Vec::new();
-        // Each sphere's cell rectangles per face: (face, u0, u1, v0, v1), inclusive.
-        let mut rects: Vec<(u32, [u32; 5])> = Vec::new();
-        for (k, &(c, r)) in spheres.iter().enumerate() {
+        let mut pairs: Vec<(u32, u32)> = Vec::new(); // (cell, sphere)
+        for &k in &order {
+            let (c, r) = spheres[k as usize];
             let rel = c - centre;
             let reach = r * (1.0 + 1e-6) + 1e-9 * rel.abs().max_element();
-            if rel.length() <= reach {
-                always.push(k as u32);
+            let dist = rel.length();
+            if dist <= reach {
+                always.push(k);
                 continue;
             }
-            let lo = rel - DVec3::splat(reach);
-            let hi = rel + DVec3::splat(reach);
+            let sphere_cone = SphereCone::new(rel, dist, r);
+            let (lo, hi) = (rel - DVec3::splat(reach), rel + DVec3::splat(reach));
             for face in 0..6u32 {
-                if let Some(rect) = face_rect(face, lo, hi, n) {
-                    rects.push((k as u32, rect));
+                let Some([u0, u1, v0, v1]) = face_rect(face, lo, hi, n) else {
+                    continue;
+                };
+                for v in v0..=v1 {
+                    for u in u0..=u1 {
+                        if cones.meets(face, u, v, &sphere_cone) {
+                            pairs.push((cell_index(face, u, v, n) as u32, k));
+                        }
+                    }
                 }
             }
         }
-        // Count, then fill (CSR).
-        let mut counts = vec![0u32; faces + 1];
-        for (_, [f, u0, u1, v0, v1]) in &rects {
-            for v in *v0..=*v1 {
-                for u in *u0..=*u1 {
-                    counts[cell_index(*f, u, v, n)] += 1;
-                }
-            }
+        // Counting sort by cell (stable: keeps the nearest-first order).
+        let mut offsets = vec![0u32; faces + 1];
+        for &(cell, _) in &pairs {
+            offsets[cell as usize + 1] += 1;
         }
-        let mut offsets = Vec::with_capacity(faces + 1);
-        let mut total = 0u32;
-        for &c in &counts[..faces] {
-            offsets.push(total);
-            total += c;
+        for c in 0..faces {
+            offsets[c + 1] += offsets[c];
         }
-        offsets.push(total);
         let mut fill = offsets.clone();
-        let mut items = vec![0u32; total as usize];
-        for (k, [f, u0, u1, v0, v1]) in &rects {
-            for v in *v0..=*v1 {
-                for u in *u0..=*u1 {
-                    let cell = cell_index(*f, u, v, n);
-                    items[fill[cell] as usize] = *k;
-                    fill[cell] += 1;
-                }
-            }
+        let mut items = vec![0u32; pairs.len()];
+        for &(cell, k) in &pairs {
+            items[fill[cell as usize] as usize] = k;
+            fill[cell as usize] += 1;
         }
-        // Nearest first in every cell, so closest-hit queries can stop early.
-        let near_of = |k: u32| {
-            let (c, r) = spheres[k as usize];
-            let d = ((c - centre).length() - r)
-                - 1e-6 * ((c - centre).length() + r + centre.abs().max_element());
-            // Round down so the early exit stays conservative.
-            let f = d as f32;
-            if f64::from(f) > d {
-                f.next_down()
-            } else {
-                f
-            }
-        };
-        let mut near = vec![0.0f32; items.len()];
-        for cell in 0..faces {
-            let range = offsets[cell] as usize..offsets[cell + 1] as usize;
-            let list = &mut items[range.clone()];
-            list.sort_unstable_by(|&a, &b| near_of(a).total_cmp(&near_of(b)));
-            for (slot, &k) in near[range].iter_mut().zip(list.iter()) {
-                *slot = near_of(k);
-            }
-        }
+        let near = items.iter().map(|&k| near_of[k as usize]).collect();
         DirGrid {
-            centre: centre.as_vec3(),
+            centre,
             n,
             offsets,
             items,
             near,
             always,
         }
+    }
+
+    pub fn debug_stats(&self) {
+        let cells = self.offsets.len() - 1;
+        let nonempty = (0..cells)
+            .filter(|&c| self.offsets[c + 1] > self.offsets[c])
+            .count();
+        let max = (0..cells)
+            .map(|c| self.offsets[c + 1] - self.offsets[c])
+            .max()
+            .unwrap_or(0);
+        eprintln!(
+            "cells {cells} nonempty {nonempty} items {} max {max} always {}",
+            self.items.len(),
+            self.always.len()
+        );
     }
 
     /// The cell of direction `d` (any length, not zero).
@@ -131,14 +142,101 @@ impl DirGrid {
     }
 }
 
+/// The cone of directions of each cell of a face (the same for all six faces in face
+/// coordinates): its axis and the cosine of its half-angle, widened.
+struct CellCones {
+    n: u32,
+    /// Per (u, v): unit axis in face coordinates (u, v, 1)/|…| and cos, sin of the half-angle.
+    cones: Vec<(DVec3, f64, f64)>,
+}
+
+impl CellCones {
+    /// The cones for `n` cells per side, computed once per process.
+    fn shared(n: u32) -> std::sync::Arc<CellCones> {
+        static CACHE: std::sync::Mutex<Vec<std::sync::Arc<CellCones>>> =
+            std::sync::Mutex::new(Vec::new());
+        let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(c) = cache.iter().find(|c| c.n == n) {
+            return c.clone();
+        }
+        let cones = std::sync::Arc::new(CellCones::new(n));
+        cache.push(cones.clone());
+        cones
+    }
+
+    fn new(n: u32) -> Self {
+        let mut cones = Vec::with_capacity((n * n) as usize);
+        let at = |i: u32| -1.0 + 2.0 * f64::from(i) / f64::from(n);
+        for v in 0..n {
+            for u in 0..n {
+                let corners = [
+                    DVec3::new(at(u), at(v), 1.0),
+                    DVec3::new(at(u + 1), at(v), 1.0),
+                    DVec3::new(at(u), at(v + 1), 1.0),
+                    DVec3::new(at(u + 1), at(v + 1), 1.0),
+                ];
+                let axis = (corners[0] + corners[3]).normalize();
+                let cos_min = corners
+                    .iter()
+                    .map(|c| c.normalize().dot(axis))
+                    .fold(1.0f64, f64::min);
+                // Widen by a fraction of the cell: query rounding lands near borders.
+                let half = cos_min.clamp(-1.0, 1.0).acos() * 1.05 + 1e-6;
+                cones.push((axis, half.cos(), half.sin()));
+            }
+        }
+        CellCones { n, cones }
+    }
+
+    /// Whether the cell's cone meets the sphere's cone.
+    #[inline]
+    fn meets(&self, face: u32, u: u32, v: u32, sphere: &SphereCone) -> bool {
+        let (axis, cos_cell, sin_cell) = self.cones[(v * self.n + u) as usize];
+        let axis = from_face(face, axis);
+        // The angle between the axes must not exceed the sum of the half-angles.
+        let cos_between = sphere.axis.dot(axis);
+        let cos_sum = cos_cell * sphere.cos - sin_cell * sphere.sin;
+        let sum_exceeds_pi = sin_cell * sphere.cos + cos_cell * sphere.sin < 0.0;
+        sum_exceeds_pi || cos_between >= cos_sum - 1e-9
+    }
+}
+
+/// The cone of directions in which a sphere is seen from the centre.
+struct SphereCone {
+    axis: DVec3,
+    cos: f64,
+    sin: f64,
+}
+
+impl SphereCone {
+    fn new(rel: DVec3, dist: f64, r: f64) -> Self {
+        let sin = (r / dist).min(1.0);
+        SphereCone {
+            axis: rel / dist,
+            cos: (1.0 - sin * sin).sqrt(),
+            sin,
+        }
+    }
+}
+
+/// A face-coordinate vector (u, v, w along the face's outward axis) in world axes.
+fn from_face(face: u32, f: DVec3) -> DVec3 {
+    let w = if face % 2 == 0 { f.z } else { -f.z };
+    match face / 2 {
+        0 => DVec3::new(w, f.x, f.y),
+        1 => DVec3::new(f.x, w, f.y),
+        _ => DVec3::new(f.x, f.y, w),
+    }
+}
+
 #[inline]
 fn cell_index(face: u32, u: u32, v: u32, n: u32) -> usize {
     ((face * n + v) * n + u) as usize
 }
 
 /// The cells of `face` that the box `[lo, hi]` (relative to the centre) may be seen in,
-/// as `[face, u0, u1, v0, v1]`, or `None` when the box is not seen in that face.
-fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 5]> {
+/// as `[u0, u1, v0, v1]`, or `None` when the box is not seen in that face.
+fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
     let axis = (face / 2) as usize;
     let (b, c) = match axis {
         0 => (1, 2),
@@ -156,7 +254,19 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 5]> {
     }
     let range = |x_lo: f64, x_hi: f64| -> (f64, f64) {
         if a_lo <= 0.0 {
-            return (-1.0, 1.0);
+            // The box reaches the face plane: a → 0⁺ sends x/a to ±∞ unless x keeps
+            // one sign, in which case the largest a bounds it on one side.
+            let min = if x_lo >= 0.0 {
+                x_lo / a_hi
+            } else {
+                f64::NEG_INFINITY
+            };
+            let max = if x_hi <= 0.0 {
+                x_hi / a_hi
+            } else {
+                f64::INFINITY
+            };
+            return (min, max);
         }
         // x/a over the box: smallest with the largest a when x ≥ 0, and so on.
         let min = x_lo / if x_lo >= 0.0 { a_hi } else { a_lo };
@@ -173,11 +283,5 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 5]> {
         let x = x.clamp(-1.0, 1.0);
         (((x + 1.0) * 0.5 * f64::from(n)) as u32).min(n - 1)
     };
-    Some([
-        face,
-        to_cell(u_lo),
-        to_cell(u_hi),
-        to_cell(v_lo),
-        to_cell(v_hi),
-    ])
+    Some([to_cell(u_lo), to_cell(u_hi), to_cell(v_lo), to_cell(v_hi)])
 }

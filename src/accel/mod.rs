@@ -6,6 +6,7 @@ mod bvh;
 mod dirgrid;
 
 use glam::{DVec3, Vec3, Vec4};
+use rayon::prelude::*;
 
 use bvh::{Aabb, Bvh};
 use dirgrid::DirGrid;
@@ -26,23 +27,49 @@ pub struct Hit {
     pub entering: bool,
 }
 
-/// A ray as the queries see it: `f32` origin and unit direction, and the sphere it was
-/// spawned on with the way it leaves it.
+/// A ray as the queries see it: origin (in `f64`: a spawn point keeps the precision of
+/// its re-projection onto its sphere), unit direction, and the sphere it was spawned on
+/// with the way it leaves it.
 #[derive(Clone, Copy, Debug)]
 pub struct Query {
-    pub origin: Vec3,
+    pub origin: DVec3,
     pub dir: Vec3,
     pub from: Option<(u32, Side)>,
 }
 
 impl Query {
     /// Crossings of other spheres closer than this are lost in the rounding of the
-    /// spawn point's `f32` coordinates and ignored.
+    /// spawn point's coordinates and ignored.
     #[inline]
     pub fn t_min(&self) -> f64 {
         match self.from {
             None => 0.0,
-            Some(_) => 4.0 * f64::from(f32::EPSILON) * f64::from(self.origin.abs().max_element()),
+            Some(_) => 16.0 * f64::EPSILON * self.origin.abs().max_element(),
+        }
+    }
+}
+
+/// A query with what every sphere test needs, computed once.
+#[derive(Clone, Copy)]
+struct Ray {
+    o64: DVec3,
+    /// The direction renormalised in `f64`: the exact tests assume `d·d = 1`, which an
+    /// `f32`-normalised direction misses by up to ~1e-7.
+    d64: DVec3,
+    d32: Vec3,
+    from: Option<(u32, Side)>,
+    t_min: f64,
+}
+
+impl Ray {
+    #[inline]
+    fn new(q: &Query) -> Ray {
+        Ray {
+            o64: q.origin,
+            d64: q.dir.as_dvec3().normalize(),
+            d32: q.dir,
+            from: q.from,
+            t_min: q.t_min(),
         }
     }
 }
@@ -135,12 +162,21 @@ impl Spheres {
             .zip(self.radius.iter().copied())
             .collect();
         let n = grid_resolution(list.len());
-        self.eye = Some(DirGrid::build(eye, &list, n));
-        self.lights = lights
-            .iter()
+        // All grids at once: they are independent.
+        let points: Vec<DVec3> = std::iter::once(eye).chain(lights.iter().copied()).collect();
+        let mut grids: Vec<DirGrid> = points
+            .par_iter()
             .map(|&p| DirGrid::build(p, &list, n))
             .collect();
+        self.lights = grids.split_off(1);
+        self.eye = grids.pop();
         self
+    }
+
+    pub fn debug_stats(&self) {
+        for g in self.eye.iter().chain(&self.lights) {
+            g.debug_stats();
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -151,11 +187,14 @@ impl Spheres {
         self.center.is_empty()
     }
 
-    /// `false` when sphere `k` certainly has no crossing in `(0, t_max)` (cheap, `f32`).
+    /// `false` when sphere `k` certainly has no crossing in `(0, t_max)` (cheap, `f32`
+    /// after one `f64` subtraction, which keeps origins far from the world's origin exact
+    /// enough).
     #[inline(always)]
-    fn may_cross(&self, k: usize, o: Vec3, d: Vec3, t_max: f32) -> bool {
+    fn may_cross(&self, k: usize, ray: &Ray, t_max: f32) -> bool {
         let s = self.quick[k];
-        let f = o - s.truncate();
+        let f = (ray.o64 - self.center[k]).as_vec3();
+        let d = ray.d32;
         let bp = -f.dot(d);
         let l = f + d * bp;
         let rr = s.w * s.w;
@@ -171,17 +210,13 @@ impl Spheres {
 
     /// The first crossing of sphere `k` in `(t_min, t_max)`: `(t, entering, normal)`.
     #[inline]
-    fn crossing(
-        &self,
-        k: usize,
-        o: DVec3,
-        d: DVec3,
-        from: Option<(u32, Side)>,
-        t_min: f64,
-        t_max: f64,
-    ) -> Option<(f64, bool, DVec3)> {
+    fn crossing(&self, k: usize, ray: &Ray, t_max: f64) -> Option<(f64, bool, DVec3)> {
+        let (o, d, t_min) = (ray.o64, ray.d64, ray.t_min);
         let (c, r) = (self.center[k], self.radius[k]);
-        let own = from.filter(|&(s, _)| s as usize == k).map(|(_, side)| side);
+        let own = ray
+            .from
+            .filter(|&(s, _)| s as usize == k)
+            .map(|(_, side)| side);
         if own == Some(Side::Outward) {
             return None;
         }
@@ -200,20 +235,13 @@ impl Spheres {
 
     /// Tests sphere `k` for the closest hit so far; returns the new `t` if it is closer.
     #[inline(always)]
-    fn consider(
-        &self,
-        k: u32,
-        q: &Query,
-        q64: (DVec3, DVec3),
-        t_min: f64,
-        best: &mut Best,
-    ) -> Option<f32> {
+    fn consider(&self, k: u32, ray: &Ray, best: &mut Best) -> Option<f32> {
         let k = k as usize;
-        let own_outward = q.from == Some((k as u32, Side::Outward));
-        if own_outward || !self.may_cross(k, q.origin, q.dir, round_up(best.t)) {
+        let own_outward = ray.from == Some((k as u32, Side::Outward));
+        if own_outward || !self.may_cross(k, ray, round_up(best.t)) {
             return None;
         }
-        let (t, entering, normal) = self.crossing(k, q64.0, q64.1, q.from, t_min, best.t)?;
+        let (t, entering, normal) = self.crossing(k, ray, best.t)?;
         *best = Best {
             t,
             k,
@@ -238,67 +266,54 @@ impl Spheres {
 
     /// The closest hit of a ray of any origin.
     pub fn closest(&self, q: &Query) -> Option<Hit> {
-        let q64 = (q.origin.as_dvec3(), q.dir.as_dvec3());
-        let t_min = q.t_min();
+        let ray = Ray::new(q);
         let mut best = Best::NONE;
         self.bvh
-            .traverse(q.origin, q.dir.recip(), f32::INFINITY, |k| {
-                self.consider(k, q, q64, t_min, &mut best)
+            .traverse(q.origin.as_vec3(), q.dir.recip(), f32::INFINITY, |k| {
+                self.consider(k, &ray, &mut best)
             });
         self.finish(best)
     }
 
     /// The closest hit of a primary ray (its origin is the camera's).
     pub fn closest_primary(&self, q: &Query) -> Option<Hit> {
-        let Some(grid) = &self.eye else {
+        let Some(grid) = self.eye.as_ref().filter(|g| g.centre == q.origin) else {
             return self.closest(q);
         };
-        debug_assert_eq!(q.origin, grid.centre);
-        let q64 = (q.origin.as_dvec3(), q.dir.as_dvec3());
+        let ray = Ray::new(q);
         let mut best = Best::NONE;
         for &k in &grid.always {
-            self.consider(k, q, q64, 0.0, &mut best);
+            self.consider(k, &ray, &mut best);
         }
         let (items, near) = grid.candidates(grid.cell(q.dir));
         for (&k, &near) in items.iter().zip(near) {
             if f64::from(near) >= best.t {
                 break; // the rest are all farther
             }
-            self.consider(k, q, q64, 0.0, &mut best);
+            self.consider(k, &ray, &mut best);
         }
         self.finish(best)
     }
 
     /// Lowers `factor` by sphere `k`'s occlusion of the shadow segment.
     #[inline(always)]
-    fn occlude(
-        &self,
-        k: u32,
-        q: &Query,
-        q64: (DVec3, DVec3),
-        t_min: f64,
-        dist: f64,
-        factor: &mut f32,
-    ) {
+    fn occlude(&self, k: u32, ray: &Ray, dist: f64, factor: &mut f32) {
         let k = k as usize;
-        if q.from == Some((k as u32, Side::Outward))
-            || !self.may_cross(k, q.origin, q.dir, round_up(dist))
-        {
+        if ray.from == Some((k as u32, Side::Outward)) || !self.may_cross(k, ray, round_up(dist)) {
             return;
         }
-        if let Some((_, _, n_k)) = self.crossing(k, q64.0, q64.1, q.from, t_min, dist) {
-            *factor = factor.min(crate::model::occluder_factor(q.dir, n_k.as_vec3()));
+        if let Some((_, _, n_k)) = self.crossing(k, ray, dist) {
+            *factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
         }
     }
 
     /// The shadow factor along the segment of length `dist` (step 4 of the model).
     pub fn shadow(&self, q: &Query, dist: f64) -> f32 {
-        let q64 = (q.origin.as_dvec3(), q.dir.as_dvec3());
-        let t_min = q.t_min();
+        let ray = Ray::new(q);
         let mut factor = 1.0f32;
         self.bvh
-            .traverse(q.origin, q.dir.recip(), round_up(dist), |k| {
-                self.occlude(k, q, q64, t_min, dist, &mut factor);
+            .traverse(q.origin.as_vec3(), q.dir.recip(), round_up(dist), |k| {
+                self.occlude(k, &ray, dist, &mut factor);
                 // A factor of 0 cannot go lower: stop looking.
                 (factor <= 0.0).then_some(-1.0)
             });
@@ -310,18 +325,17 @@ impl Spheres {
         let Some(grid) = self.lights.get(light) else {
             return self.shadow(q, dist);
         };
-        let q64 = (q.origin.as_dvec3(), q.dir.as_dvec3());
-        let t_min = q.t_min();
+        let ray = Ray::new(q);
         let mut factor = 1.0f32;
         for &k in &grid.always {
-            self.occlude(k, q, q64, t_min, dist, &mut factor);
+            self.occlude(k, &ray, dist, &mut factor);
         }
-        let (items, near) = grid.candidates(grid.cell(q.origin - grid.centre));
+        let (items, near) = grid.candidates(grid.cell((q.origin - grid.centre).as_vec3()));
         for (&k, &near) in items.iter().zip(near) {
             if f64::from(near) >= dist || factor <= 0.0 {
                 break; // beyond the hit point, seen from the light
             }
-            self.occlude(k, q, q64, t_min, dist, &mut factor);
+            self.occlude(k, &ray, dist, &mut factor);
         }
         factor
     }

@@ -2,7 +2,7 @@
 //! scene compiled once ([`crate::accel`]) and the intersection maths in `f64` where
 //! `f32` cannot hold.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use super::{RayCounts, SampleTracer};
 use crate::accel::{Query, Spheres};
@@ -21,7 +21,7 @@ struct Material {
 
 #[derive(Clone, Copy)]
 struct Light {
-    position: Vec3,
+    position: DVec3,
     intensity: Vec3,
 }
 
@@ -31,8 +31,9 @@ pub struct FastTracer {
     lights: Vec<Light>,
     sky_down: Vec3,
     sky_up: Vec3,
-    origin: Vec3,
-    lower_left: Vec3,
+    origin: DVec3,
+    /// `LL − O`, rounded once from `f64`.
+    corner: Vec3,
     horizontal: Vec3,
     vertical: Vec3,
     max_depth: u32,
@@ -53,12 +54,8 @@ impl FastTracer {
     pub fn new(scene: &Scene, camera: &Camera, max_depth: u32) -> Self {
         FastTracer {
             spheres: Spheres::new(&scene.spheres).with_grids(
-                camera.origin.as_vec3().as_dvec3(),
-                &scene
-                    .lights
-                    .iter()
-                    .map(|l| l.position.as_vec3().as_dvec3())
-                    .collect::<Vec<_>>(),
+                camera.origin,
+                &scene.lights.iter().map(|l| l.position).collect::<Vec<_>>(),
             ),
             materials: scene
                 .spheres
@@ -75,14 +72,14 @@ impl FastTracer {
                 .lights
                 .iter()
                 .map(|l| Light {
-                    position: l.position.as_vec3(),
+                    position: l.position,
                     intensity: l.intensity.as_vec3(),
                 })
                 .collect(),
             sky_down: scene.sky.down.as_vec3(),
             sky_up: scene.sky.up.as_vec3(),
-            origin: camera.origin.as_vec3(),
-            lower_left: camera.lower_left.as_vec3(),
+            origin: camera.origin,
+            corner: (camera.lower_left - camera.origin).as_vec3(),
             horizontal: camera.horizontal.as_vec3(),
             vertical: camera.vertical.as_vec3(),
             max_depth,
@@ -139,9 +136,8 @@ impl FastTracer {
         let front = hit.entering;
         let n = hit.normal.as_vec3();
         let nf = if front { n } else { -n };
-        let point = hit.point.as_vec3();
         let spawn = |dir: Vec3, inside: bool| Query {
-            origin: point,
+            origin: hit.point,
             dir,
             from: Some((hit.sphere, Side::inside(inside))),
         };
@@ -150,8 +146,8 @@ impl FastTracer {
         let w_local = weight * (1.0 - m.w_t) * (1.0 - m.w_r);
         if m.branches.local && self.keep(w_local, skipped) {
             for (index, light) in self.lights.iter().enumerate() {
-                // The light direction from the f64 point: the f32 one may sit off the sphere.
-                let to_light = light.position.as_dvec3() - hit.point;
+                // From the f64 point, which lies on the sphere.
+                let to_light = light.position - hit.point;
                 let dist = to_light.length();
                 let l = (to_light / dist).as_vec3();
                 let cos = nf.dot(l);
@@ -200,14 +196,7 @@ impl SampleTracer for FastTracer {
     }
 
     fn sample_bounded(&self, s: f32, t: f32, counts: &mut RayCounts) -> (Vec3, f32) {
-        let dir = model::primary_direction(
-            self.origin,
-            self.lower_left,
-            self.horizontal,
-            self.vertical,
-            s,
-            t,
-        );
+        let dir = model::primary_direction(self.corner, self.horizontal, self.vertical, s, t);
         let ray = Query {
             origin: self.origin,
             dir,
