@@ -115,23 +115,21 @@ pub fn many_scene(n: usize) -> Scene {
             ..Sphere::new(DVec3::new(x, y, z), r)
         });
     }
-    let hw3 = hw3_scene(HW3_DEFAULT_SEED);
-    Scene {
-        name: format!("many_{n}"),
-        camera: Some(CameraSpec::LookAt {
-            look_from: DVec3::new(0.0, 18.0, 60.0),
-            look_at: DVec3::new(0.0, 0.0, -8.0),
-            up: DVec3::Y,
-            vfov: 45.0,
-        }),
-        image: hw3.image,
-        sky: hw3.sky,
-        lights: vec![Light {
-            position: DVec3::new(-30.0, 60.0, 40.0),
-            intensity: DVec3::ONE,
-        }],
-        spheres,
-    }
+    // From the built-in scene, so that fields added to scenes keep their defaults.
+    let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+    scene.name = format!("many_{n}");
+    scene.camera = Some(CameraSpec::LookAt {
+        look_from: DVec3::new(0.0, 18.0, 60.0),
+        look_at: DVec3::new(0.0, 0.0, -8.0),
+        up: DVec3::Y,
+        vfov: 45.0,
+    });
+    scene.lights = vec![Light {
+        position: DVec3::new(-30.0, 60.0, 40.0),
+        intensity: DVec3::ONE,
+    }];
+    scene.spheres = spheres;
+    scene
 }
 
 /// One setting of the grid; `preset` names it when it is a preset's.
@@ -177,11 +175,16 @@ pub fn grid(tiny: bool) -> Vec<Setting> {
         for d in [1, 2, 3, 4, 8, 16] {
             qs.push(fast(1, None, 0.0, d));
         }
-        qs.push(fast(9, Some(0.03), 0.0, 8));
-        qs.push(fast(16, None, 0.0, 16));
-        qs.push(fast(16, Some(0.1), 0.0, 8));
-        qs.push(fast(16, Some(0.03), 0.0, 8));
-        qs.push(fast(16, Some(0.03), 0.01, 8));
+        // Fixed spp at depth 16, the comparison for the presets (same depth, no
+        // adaptive sampling); 1 spp at depth 16 is in the depth sweep.
+        for spp in [4, 9, 16, 36, 64] {
+            qs.push(fast(spp, None, 0.0, 16));
+        }
+        qs.push(fast(9, Some(0.03), 0.0, 16));
+        qs.push(fast(16, Some(0.1), 0.0, 16));
+        qs.push(fast(16, Some(0.03), 0.0, 16));
+        qs.push(fast(16, Some(0.03), 0.01, 16));
+        qs.push(fast(64, Some(0.03), 0.0, 16));
         qs.push(fast(64, Some(0.01), 0.0, 16));
         qs.push(Quality {
             precision: Renderer::Reference,
@@ -388,6 +391,17 @@ fn reference(
         opts.height,
     )
         .hash(&mut h);
+    // A tiny render of the same scene stands for the reference code: if that code
+    // changes what it computes, the probe (almost surely) changes and the cache misses.
+    let probe = BenchOptions {
+        width: 8,
+        height: 8,
+        ..opts.clone()
+    };
+    let probe_q = Quality { spp: 4, ..q };
+    for p in render_once(scene, &probe_q, &probe)?.0.pixels {
+        p.to_array().map(f32::to_bits).hash(&mut h);
+    }
     let path = dir.join(format!(
         "{}-{}x{}-{:016x}.f32",
         scene.name,
@@ -570,9 +584,9 @@ fn scene_names(rows: &[Row]) -> Vec<String> {
     names
 }
 
-/// The time a fixed-spp render (no other knob) would need for `rmse`, interpolated
-/// log-log between the measured spp sweep; `None` outside the sweep.
-pub fn fixed_spp_time_for(rows: &[Row], scene: &str, rmse: f64) -> Option<f64> {
+/// The time a fixed-spp render at depth `max_depth` (no other knob) would need for
+/// `rmse`, interpolated log-log between the measured spp sweep; `None` outside it.
+pub fn fixed_spp_time_for(rows: &[Row], scene: &str, max_depth: u32, rmse: f64) -> Option<f64> {
     let mut sweep: Vec<(f64, f64)> = rows
         .iter()
         .filter(|r| {
@@ -580,7 +594,7 @@ pub fn fixed_spp_time_for(rows: &[Row], scene: &str, rmse: f64) -> Option<f64> {
             r.scene == scene
                 && q.adaptive.is_none()
                 && q.cutoff == 0.0
-                && q.max_depth == 5
+                && q.max_depth == max_depth
                 && q.precision == Renderer::Fast
         })
         .map(|r| (r.errors.rmse, r.median_s))
@@ -592,6 +606,30 @@ pub fn fixed_spp_time_for(rows: &[Row], scene: &str, rmse: f64) -> Option<f64> {
             let f = (e0.ln() - rmse.ln()) / (e0.ln() - e1.ln());
             (t0.ln() + f * (t1.ln() - t0.ln())).exp()
         })
+    })
+}
+
+/// The knee of a scene's front (fast tracer only): the point farthest below the chord
+/// joining the fastest and the most accurate front points, in log-log coordinates.
+pub fn knee<'a>(rows: &'a [Row], scene: &str) -> Option<&'a Row> {
+    let mut front: Vec<&Row> = rows
+        .iter()
+        .filter(|r| {
+            r.scene == scene
+                && r.pareto
+                && r.errors.rmse > 0.0
+                && r.setting.quality.precision == Renderer::Fast
+        })
+        .collect();
+    front.sort_by(|a, b| a.median_s.total_cmp(&b.median_s));
+    let p = |r: &Row| (r.median_s.ln(), r.errors.rmse.ln());
+    let (a, b) = (p(front.first()?), p(front.last()?));
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let len = (dx * dx + dy * dy).sqrt().max(1e-12);
+    // Signed distance below the chord (positive = better than the straight trade).
+    front.into_iter().max_by(|r, s| {
+        let d = |q: (f64, f64)| (dx * (q.1 - a.1) - dy * (q.0 - a.0)) / len;
+        (-d(p(r))).total_cmp(&-d(p(s)))
     })
 }
 
@@ -612,7 +650,7 @@ fn markdown(rows: &[Row], opts: &BenchOptions) -> String {
     let _ = writeln!(
         md,
         "| scene | preset | setting | time ms | RMSE | PSNR dB | >1 level | max | FLIP | \
-         vs 1 spp | vs fixed spp of same RMSE |\n|---|---|---|---|---|---|---|---|---|---|---|"
+         vs 1 spp | vs fixed spp, same depth and RMSE |\n|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for name in scene_names(rows) {
         let plain = rows
@@ -625,10 +663,11 @@ fn markdown(rows: &[Row], opts: &BenchOptions) -> String {
             let vs_plain = plain.map_or("-".to_string(), |p| {
                 format!("{:.2}× the time", r.median_s / p.median_s)
             });
-            let vs_fixed = fixed_spp_time_for(rows, &name, r.errors.rmse)
-                .map_or("outside the sweep".to_string(), |t| {
-                    format!("{:.2}× the time ({:.1} ms)", r.median_s / t, t * 1e3)
-                });
+            let vs_fixed =
+                fixed_spp_time_for(rows, &name, r.setting.quality.max_depth, r.errors.rmse)
+                    .map_or("outside the sweep".to_string(), |t| {
+                        format!("{:.2}× the time ({:.1} ms)", r.median_s / t, t * 1e3)
+                    });
             let _ = writeln!(
                 md,
                 "| {} | {} | `{}` | {:.1} | {:.3} | {:.1} | {:.3}% | {} | {:.4} | {} | {} |",
@@ -643,6 +682,22 @@ fn markdown(rows: &[Row], opts: &BenchOptions) -> String {
                 r.errors.flip,
                 vs_plain,
                 vs_fixed
+            );
+        }
+    }
+    let _ = writeln!(
+        md,
+        "\nKnee of each front (the front point farthest below the chord from its fastest \
+         to its most accurate fast-tracer point, in log time and log RMSE):\n"
+    );
+    for name in scene_names(rows) {
+        if let Some(k) = knee(rows, &name) {
+            let _ = writeln!(
+                md,
+                "- {name}: `{}` ({:.1} ms, RMSE {:.3})",
+                k.setting.quality.label(),
+                k.median_s * 1e3,
+                k.errors.rmse
             );
         }
     }
@@ -799,4 +854,38 @@ fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
     }
     root.present().map_err(|x| e(&x))?;
     Ok(())
+}
+
+/// Parses `WxH` (each side 1 to 4096) for `--size`.
+pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let parsed = text
+        .split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) if (1..=4096).contains(&w) && (1..=4096).contains(&h) => Ok((w, h)),
+        _ => Err(format!(
+            "expected WxH with each side from 1 to 4096, such as 320x180; got \"{text}\""
+        )),
+    }
+}
+
+/// A few lines for the terminal: where the outputs went and each preset's figures.
+pub fn summary(rows: &[Row], out: &Path) -> String {
+    let mut s = String::new();
+    for f in ["bench.csv", "bench.md", "bench.svg"] {
+        let _ = writeln!(s, "wrote {}", out.join(f).display());
+    }
+    for r in rows.iter().filter(|r| r.setting.preset.is_some()) {
+        let _ = writeln!(
+            s,
+            "{:<10} {:<9} {:>9.1} ms  RMSE {:>6.3} levels  >1 level {:>6.3}%  max {:>3}",
+            r.scene,
+            r.setting.preset.map_or("", |p| p.name()),
+            r.median_s * 1e3,
+            r.errors.rmse,
+            r.errors.off_by_more_than_1 * 100.0,
+            r.errors.max
+        );
+    }
+    s
 }

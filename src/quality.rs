@@ -171,7 +171,7 @@ impl Preset {
                 spp: 16,
                 adaptive: Some(Adaptive::with_threshold(0.03)),
                 cutoff: 0.0,
-                max_depth: 8,
+                max_depth: 16,
                 precision: Renderer::Fast,
             },
             Preset::High => Quality {

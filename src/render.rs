@@ -52,15 +52,24 @@ pub struct RenderOptions {
 
 impl RenderOptions {
     /// The scene's own settings, all of the image, all cores, the fast tracer.
+    /// With a quality preset in the scene file, its knobs (its spp and depth are
+    /// already in the scene's image settings).
     pub fn for_scene(scene: &Scene) -> Self {
-        RenderOptions {
+        let mut opts = RenderOptions {
             image: scene.image,
             region: None,
             threads: None,
             renderer: Renderer::Fast,
             adaptive: None,
             cutoff: 0.0,
+        };
+        if let Some(preset) = scene.image.quality {
+            let q = preset.quality();
+            opts.adaptive = q.adaptive;
+            opts.cutoff = q.cutoff;
+            opts.renderer = q.precision;
         }
+        opts
     }
 
     /// These options with the settings of `quality` (see [`Quality::apply`]).

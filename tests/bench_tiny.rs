@@ -31,7 +31,10 @@ fn tiny_study_writes_a_complete_csv_table_and_plot() {
     assert_eq!(body.len(), rows.len());
     for row in &body {
         assert_eq!(row.len(), header.len(), "{row:?}");
-        assert!(row.iter().all(|c| !c.trim().is_empty()), "empty cell in {row:?}");
+        assert!(
+            row.iter().all(|c| !c.trim().is_empty()),
+            "empty cell in {row:?}"
+        );
         assert_eq!(row[col("runs")].parse::<usize>().unwrap() >= 1, true);
         let median: f64 = row[col("median_s")].parse().unwrap();
         assert!(median > 0.0);
@@ -41,7 +44,11 @@ fn tiny_study_writes_a_complete_csv_table_and_plot() {
     }
     for s in &scenes {
         let these: Vec<&Vec<&str>> = body.iter().filter(|r| r[0] == s.name).collect();
-        assert!(these.iter().any(|r| r[col("pareto")] == "true"), "{}", s.name);
+        assert!(
+            these.iter().any(|r| r[col("pareto")] == "true"),
+            "{}",
+            s.name
+        );
         // The fastest setting is on the front by definition.
         let fastest = these
             .iter()
@@ -51,7 +58,10 @@ fn tiny_study_writes_a_complete_csv_table_and_plot() {
             })
             .unwrap();
         assert_eq!(fastest[col("pareto")], "true");
-        let reference = these.iter().find(|r| r[col("preset")] == "reference").unwrap();
+        let reference = these
+            .iter()
+            .find(|r| r[col("preset")] == "reference")
+            .unwrap();
         assert_eq!(reference[col("rmse_levels")], "0.0000");
         // Timed settings ran the asked number of times.
         assert!(these
@@ -102,7 +112,10 @@ fn errors_are_measured_in_displayed_levels() {
     let same = bench::compare(&reference, &reference);
     assert_eq!(same.rmse, 0.0);
     assert!(same.psnr.is_infinite());
-    assert_eq!((same.max, same.off_by_more_than_1, same.flip), (0, 0.0, 0.0));
+    assert_eq!(
+        (same.max, same.off_by_more_than_1, same.flip),
+        (0, 0.0, 0.0)
+    );
 
     // One channel of one pixel 10 levels off; another pixel above 1 (clamped: no error).
     let mut pixels = vec![Vec3::splat(0.5); 4];
@@ -117,4 +130,14 @@ fn errors_are_measured_in_displayed_levels() {
     assert_eq!(e.max, 10);
     assert_eq!(e.off_by_more_than_1, 0.25);
     assert!(e.flip > 0.0);
+}
+
+#[test]
+fn size_option_parses_and_rejects_clearly() {
+    assert_eq!(bench::parse_size("320x180"), Ok((320, 180)));
+    assert_eq!(bench::parse_size("16X9"), Ok((16, 9)));
+    for bad in ["0x9", "320", "x", "320x", "5000x10", "-1x5", "axb"] {
+        let e = bench::parse_size(bad).unwrap_err();
+        assert!(e.contains("WxH") && e.contains(bad), "{e}");
+    }
 }

@@ -32,19 +32,22 @@ fn small_scene() -> impl Strategy<Value = Scene> {
         prop_oneof![Just(0.0), Just(1.0), 0.0f64..1.0],
         1.0f64..2.5,
     )
-        .prop_map(|((x, y, z), r, (cr, cg, cb), reflect, transmit, ior)| Sphere {
-            color: DVec3::new(cr, cg, cb),
-            reflect,
-            transmit,
-            ior,
-            ..Sphere::new(DVec3::new(x, y, z), r)
+        .prop_map(
+            |((x, y, z), r, (cr, cg, cb), reflect, transmit, ior)| Sphere {
+                color: DVec3::new(cr, cg, cb),
+                reflect,
+                transmit,
+                ior,
+                ..Sphere::new(DVec3::new(x, y, z), r)
+            },
+        );
+    let light =
+        ((-10.0f64..10.0, 0.0f64..10.0, -5.0f64..5.0), 0.0f64..1.0).prop_map(|((x, y, z), i)| {
+            Light {
+                position: DVec3::new(x, y, z),
+                intensity: DVec3::splat(i),
+            }
         });
-    let light = ((-10.0f64..10.0, 0.0f64..10.0, -5.0f64..5.0), 0.0f64..1.0).prop_map(
-        |((x, y, z), i)| Light {
-            position: DVec3::new(x, y, z),
-            intensity: DVec3::splat(i),
-        },
-    );
     (
         prop::collection::vec(sphere, 1..7),
         prop::collection::vec(light, 0..3),
@@ -129,10 +132,30 @@ fn adaptive_region_is_the_crop_of_the_whole_image() {
     opts.adaptive = Some(Adaptive::with_threshold(0.05));
     let (whole, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
     for region in [
-        Region { x: 0, y: 0, width: 64, height: 36 },
-        Region { x: 10, y: 5, width: 17, height: 9 },
-        Region { x: 63, y: 35, width: 1, height: 1 },
-        Region { x: 0, y: 20, width: 30, height: 16 },
+        Region {
+            x: 0,
+            y: 0,
+            width: 64,
+            height: 36,
+        },
+        Region {
+            x: 10,
+            y: 5,
+            width: 17,
+            height: 9,
+        },
+        Region {
+            x: 63,
+            y: 35,
+            width: 1,
+            height: 1,
+        },
+        Region {
+            x: 0,
+            y: 20,
+            width: 30,
+            height: 16,
+        },
     ] {
         opts.region = Some(region);
         let (part, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
@@ -158,7 +181,11 @@ fn adaptive_refines_edges_not_flat_sky_and_stays_close_to_full_aa() {
     opts.adaptive = Some(Adaptive::with_threshold(0.03));
     let a = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
     let n = 96 * 54;
-    assert!(a.refined > 0 && a.refined < n as u64 / 2, "refined {}", a.refined);
+    assert!(
+        a.refined > 0 && a.refined < n as u64 / 2,
+        "refined {}",
+        a.refined
+    );
     // Unrefined pixels: the mean of 4 samples that agreed within the threshold, so
     // within the threshold of the full mean wherever the pixel is smooth.
     let far: usize = a
@@ -168,7 +195,10 @@ fn adaptive_refines_edges_not_flat_sky_and_stays_close_to_full_aa() {
         .zip(&full.pixels)
         .filter(|(x, y)| (**x - **y).abs().max_element() > 0.03)
         .count();
-    assert!(far * 100 < n, "{far} pixels differ by more than the threshold");
+    assert!(
+        far * 100 < n,
+        "{far} pixels differ by more than the threshold"
+    );
 
     // Only sky, no ball: nothing but smooth gradients, so no pixel needs refining.
     let mut sky = scene.clone();
@@ -219,7 +249,9 @@ fn every_preset_renders_and_better_presets_err_less() {
             .pixels
             .iter()
             .zip(&reference.pixels)
-            .map(|(a, b)| (a.clamp(Vec3::ZERO, Vec3::ONE) - b.clamp(Vec3::ZERO, Vec3::ONE)).length_squared())
+            .map(|(a, b)| {
+                (a.clamp(Vec3::ZERO, Vec3::ONE) - b.clamp(Vec3::ZERO, Vec3::ONE)).length_squared()
+            })
             .sum();
         errors.push(sq);
         assert_eq!(preset.name().parse::<Preset>(), Ok(preset));
@@ -231,7 +263,10 @@ fn every_preset_renders_and_better_presets_err_less() {
 #[test]
 fn unknown_preset_and_bad_knobs_are_clear_errors() {
     let e = "fast".parse::<Preset>().unwrap_err();
-    assert!(e.contains("fast") && e.contains("draft, default, high or reference"), "{e}");
+    assert!(
+        e.contains("fast") && e.contains("draft, default, high or reference"),
+        "{e}"
+    );
     let (scene, mut opts) = hw3_opts(8, 8, 1);
     opts.cutoff = f32::NAN;
     assert!(render(&scene, &opts, &RenderControl::default()).is_err());
@@ -253,4 +288,48 @@ fn reference_precision_ignores_the_cutoff() {
     opts.cutoff = 0.3;
     let (cut, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
     assert_eq!(exact, cut);
+}
+
+#[test]
+fn scene_file_quality_key_sets_the_preset_and_explicit_keys_win() {
+    let text = "[image]\nquality = \"default\"\nwidth = 16\nheight = 9\n\n\
+                [[sphere]]\ncenter = [0, 0, -2]\nradius = 0.5\n";
+    let scene = Scene::from_toml_str(text, "q.toml").unwrap();
+    let q = Preset::Default.quality();
+    assert_eq!(scene.image.quality, Some(Preset::Default));
+    assert_eq!(
+        (scene.image.spp, scene.image.max_depth),
+        (q.spp, q.max_depth)
+    );
+    assert_eq!(Quality::of(&RenderOptions::for_scene(&scene)), q);
+    // The written scene keeps the key and loads back the same.
+    let again = Scene::from_toml_str(&whitted::scene::to_toml(&scene), "w.toml").unwrap();
+    assert_eq!(again.image, scene.image);
+
+    let text =
+        "[image]\nquality = \"high\"\nspp = 4\n\n[[sphere]]\ncenter = [0, 0, -2]\nradius = 0.5\n";
+    let scene = Scene::from_toml_str(text, "q.toml").unwrap();
+    let opts = RenderOptions::for_scene(&scene);
+    assert_eq!(opts.image.spp, 4);
+    assert_eq!(opts.image.max_depth, Preset::High.quality().max_depth);
+    assert_eq!(opts.adaptive, Preset::High.quality().adaptive);
+
+    let text = "[image]\nquality = \"ultra\"\n";
+    let e = Scene::from_toml_str(text, "bad.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("bad.toml:2:"), "{e}");
+    assert!(
+        e.contains("ultra") && e.contains("draft, default, high or reference"),
+        "{e}"
+    );
+}
+
+#[test]
+fn scenes_without_the_key_render_as_before() {
+    let scene = hw3_scene(2020);
+    assert_eq!(scene.image.quality, None);
+    let opts = RenderOptions::for_scene(&scene);
+    assert_eq!(Quality::of(&opts), Quality::default());
+    assert_eq!(Quality::default(), Preset::Draft.quality());
 }

@@ -45,6 +45,7 @@ struct FileImage {
     max_depth: Option<Int>,
     spp: Option<Int>,
     seed: Option<Int>,
+    quality: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -160,6 +161,16 @@ pub(super) fn parse(text: &str, path: &str) -> Result<Scene, SceneError> {
 
     let mut image = ImageSettings::default();
     if let Some(img) = &file.image {
+        // A quality preset first: the file's own spp and max_depth override its values.
+        if let Some(q) = &img.quality {
+            let preset: crate::quality::Preset = q
+                .get_ref()
+                .parse()
+                .map_err(|m: String| at.at(q.span(), format!("image.quality: {m}")))?;
+            image.spp = preset.quality().spp;
+            image.max_depth = preset.quality().max_depth;
+            image.quality = Some(preset);
+        }
         let dims = [
             (
                 &img.width,
