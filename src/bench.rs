@@ -218,7 +218,8 @@ pub struct BenchOptions {
     pub out: PathBuf,
     pub width: u32,
     pub height: u32,
-    /// Timed runs per setting (at least 5 for the published study).
+    /// Timed runs per setting, at least (5 for the published study); fast settings
+    /// get more, up to ten times as many.
     pub runs: usize,
     /// The small grid and scenes (for tests).
     pub tiny: bool,
@@ -351,6 +352,9 @@ fn precision_name(r: Renderer) -> &'static str {
     }
 }
 
+/// Timed runs per setting aim to add up to this (within `runs` to 10 × `runs`).
+const TIMING_BUDGET_S: f64 = 0.3;
+
 /// Renders `scene` with `quality`; returns the frame, its cutoff bound (levels), the
 /// share of refined pixels, rays and seconds.
 fn render_once(
@@ -376,12 +380,13 @@ fn render_once(
 }
 
 /// The converged reference of a scene, from the cache in `dir` when a previous run
-/// made it for the same scene, size and settings; with its render time when rendered.
+/// made it for the same scene, size and settings; with the time and rays of the render
+/// that made it.
 fn reference(
     scene: &Scene,
     opts: &BenchOptions,
     dir: &Path,
-) -> anyhow::Result<(Frame, Option<(f64, u64)>)> {
+) -> anyhow::Result<(Frame, (f64, u64))> {
     let q = Preset::Reference.quality();
     let mut h = DefaultHasher::new();
     (
@@ -410,8 +415,12 @@ fn reference(
         h.finish()
     ));
     let n = opts.width as usize * opts.height as usize;
-    if let Ok(bytes) = std::fs::read(&path) {
-        if bytes.len() == n * 12 {
+    let timing = path.with_extension("time");
+    if let (Ok(bytes), Ok(t)) = (std::fs::read(&path), std::fs::read_to_string(&timing)) {
+        let cost = t
+            .split_once(' ')
+            .and_then(|(s, r)| Some((s.parse::<f64>().ok()?, r.trim().parse::<u64>().ok()?)));
+        if let (true, Some(cost)) = (bytes.len() == n * 12, cost) {
             let floats: Vec<f32> = bytes
                 .chunks_exact(4)
                 .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
@@ -425,7 +434,7 @@ fn reference(
                 height: opts.height,
                 pixels,
             };
-            return Ok((frame, None));
+            return Ok((frame, cost));
         }
     }
     let (frame, _, _, rays, seconds) = render_once(scene, &q, opts)?;
@@ -437,7 +446,9 @@ fn reference(
         .collect();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     std::fs::write(&path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
-    Ok((frame, Some((seconds, rays))))
+    std::fs::write(&timing, format!("{seconds} {rays}\n"))
+        .with_context(|| format!("cannot write {}", timing.display()))?;
+    Ok((frame, (seconds, rays)))
 }
 
 /// Marks the rows of each scene that no other row of that scene beats in both median
@@ -490,11 +501,13 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<Vec<Row>> {
         bar.set_message(format!("{}: reference (f64, 256 spp, depth 16)", bs.name));
         let (refr, ref_time) = reference(&bs.scene, opts, &opts.out.join("cache"))?;
         bar.inc(1);
-        // Run 0 of every setting gives the image; the timed runs then cycle through the
-        // settings, so that a burst of load from other programs spreads over all of
-        // them instead of spoiling the runs of one.
+        // A first, untimed render of every setting gives the image (and warms up).
+        // The timed runs then cycle through the settings, so that a burst of load from
+        // other programs spreads over all of them instead of spoiling one; settings
+        // that render in a few milliseconds get more runs (up to 10×), as their times
+        // are the noisiest.
         let first = rows.len();
-        let mut times: Vec<Vec<f64>> = Vec::with_capacity(settings.len());
+        let mut wanted: Vec<usize> = Vec::with_capacity(settings.len());
         for setting in &settings {
             bar.set_message(format!("{}: {}", bs.name, setting.quality.label()));
             let (frame, bound, refined, rays, seconds) =
@@ -509,11 +522,13 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<Vec<Row>> {
             } else {
                 0
             };
-            times.push(vec![seconds]);
+            let runs = ((TIMING_BUDGET_S / seconds.max(1e-6)).ceil() as usize)
+                .clamp(opts.runs, opts.runs * 10);
+            wanted.push(runs);
             rows.push(Row {
                 scene: bs.name.clone(),
                 setting: *setting,
-                runs: opts.runs,
+                runs,
                 median_s: 0.0,
                 min_s: 0.0,
                 rays,
@@ -525,18 +540,28 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<Vec<Row>> {
             });
             bar.inc(1);
         }
-        for run in 1..opts.runs {
-            bar.set_message(format!("{}: timed run {}/{}", bs.name, run + 1, opts.runs));
-            for (setting, t) in settings.iter().zip(times.iter_mut()) {
-                t.push(render_once(&bs.scene, &setting.quality, opts)?.4);
+        let mut times: Vec<Vec<f64>> = vec![Vec::new(); settings.len()];
+        let cycles = wanted.iter().copied().max().unwrap_or(0);
+        for run in 0..cycles {
+            bar.set_message(format!(
+                "{}: timed runs, cycle {}/{cycles}",
+                bs.name,
+                run + 1
+            ));
+            for ((setting, t), &n) in settings.iter().zip(times.iter_mut()).zip(&wanted) {
+                if run < n {
+                    t.push(render_once(&bs.scene, &setting.quality, opts)?.4);
+                }
             }
         }
         for (row, t) in rows[first..].iter_mut().zip(times.iter_mut()) {
             row.min_s = t.iter().copied().fold(f64::INFINITY, f64::min);
             row.median_s = median(t);
         }
-        if let Some((seconds, rays)) = ref_time {
-            // The reference preset is the reference: error 0 by definition, one run.
+        {
+            // The reference preset is the reference: error 0 by definition, one run
+            // (when it came from the cache, the run that made it).
+            let (seconds, rays) = ref_time;
             rows.push(Row {
                 scene: bs.name.clone(),
                 setting: Setting {
@@ -609,35 +634,51 @@ pub fn fixed_spp_time_for(rows: &[Row], scene: &str, max_depth: u32, rmse: f64) 
     })
 }
 
-/// The knee of a scene's front (fast tracer only): the point farthest below the chord
-/// joining the fastest and the most accurate front points, in log-log coordinates.
+/// The knee of a scene's front, "Kneedle" style: time and RMSE scaled to [0,1] between
+/// the plain setting (1 spp, depth 5, exact: the program's default) and the cheapest
+/// front point within 10% of the best RMSE of the fast tracer; the knee is the front
+/// point in between farthest below the straight line joining those two, where extra
+/// time stops buying much error.
 pub fn knee<'a>(rows: &'a [Row], scene: &str) -> Option<&'a Row> {
+    let plain = rows
+        .iter()
+        .find(|r| r.scene == scene && r.setting.quality == fast(1, None, 0.0, 5))?;
     let mut front: Vec<&Row> = rows
         .iter()
         .filter(|r| {
             r.scene == scene
                 && r.pareto
-                && r.errors.rmse > 0.0
                 && r.setting.quality.precision == Renderer::Fast
+                && r.median_s >= plain.median_s
+                && r.errors.rmse <= plain.errors.rmse
         })
         .collect();
     front.sort_by(|a, b| a.median_s.total_cmp(&b.median_s));
-    let p = |r: &Row| (r.median_s.ln(), r.errors.rmse.ln());
-    let (a, b) = (p(front.first()?), p(front.last()?));
-    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
-    let len = (dx * dx + dy * dy).sqrt().max(1e-12);
-    // Signed distance below the chord (positive = better than the straight trade).
-    front.into_iter().max_by(|r, s| {
-        let d = |q: (f64, f64)| (dx * (q.1 - a.1) - dy * (q.0 - a.0)) / len;
-        (-d(p(r))).total_cmp(&-d(p(s)))
-    })
+    let best = front
+        .iter()
+        .map(|r| r.errors.rmse)
+        .fold(f64::INFINITY, f64::min);
+    let end = front.iter().position(|r| r.errors.rmse <= best * 1.1)?;
+    let last = front[end];
+    let (t0, t1) = (plain.median_s, last.median_s);
+    let (e0, e1) = (plain.errors.rmse, last.errors.rmse);
+    if t1 <= t0 || e0 <= e1 {
+        return None;
+    }
+    // Scaled so that the chord runs from (0, 1) to (1, 0): distance below it is 1 − x − y.
+    let below = |r: &Row| 1.0 - (r.median_s - t0) / (t1 - t0) - (r.errors.rmse - e1) / (e0 - e1);
+    front[..=end]
+        .iter()
+        .copied()
+        .max_by(|a, b| below(a).total_cmp(&below(b)))
 }
 
 fn markdown(rows: &[Row], opts: &BenchOptions) -> String {
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "# Run time against error\n\n{}x{} pixels, median of {} runs, threads: {}. Error \
+        "# Run time against error\n\n{}x{} pixels, median of at least {} timed runs after an \
+         untimed one (more, up to 10×, for settings that take milliseconds), threads: {}. Error \
          against the converged reference (f64, 256 stratified spp, depth 16), both clamped \
          to [0,1]; RMSE and max in 8-bit levels; FLIP mean in [0,1]. ★ = on the scene's \
          Pareto front of (time, RMSE).\n",
@@ -687,8 +728,9 @@ fn markdown(rows: &[Row], opts: &BenchOptions) -> String {
     }
     let _ = writeln!(
         md,
-        "\nKnee of each front (the front point farthest below the chord from its fastest \
-         to its most accurate fast-tracer point, in log time and log RMSE):\n"
+        "\nKnee of each front (time and RMSE scaled to [0,1] between the plain setting, \
+         1 spp at depth 5, and the cheapest front point within 10% of the best RMSE; the \
+         knee is the front point farthest below the line joining them):\n"
     );
     for name in scene_names(rows) {
         if let Some(k) = knee(rows, &name) {
@@ -739,17 +781,25 @@ fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
     let names = scene_names(rows);
     let cols = 2usize;
     let panels_y = names.len().div_ceil(cols).max(1);
-    let root = SVGBackend::new(path, (1200, 480 * panels_y as u32)).into_drawing_area();
+    let legend_h = 36;
+    let root = SVGBackend::new(path, (1200, 480 * panels_y as u32 + legend_h)).into_drawing_area();
     let e = |err: &dyn std::fmt::Display| anyhow::anyhow!("plot: {err}");
     root.fill(&WHITE).map_err(|x| e(&x))?;
-    let panels = root.split_evenly((panels_y, cols));
-    // RMSE 0 (the reference preset) cannot sit on a log axis: floor it.
-    let floor = 0.01;
+    let (top, bottom) = root.split_vertically(480 * panels_y as u32);
+    let panels = top.split_evenly((panels_y, cols));
+    // Explicit light greys: some SVG renderers ignore opacity.
+    let grid_bold = RGBColor(200, 200, 200);
+    let grid_light = RGBColor(235, 235, 235);
     for (name, panel) in names.iter().zip(panels.iter()) {
-        let these: Vec<&Row> = rows.iter().filter(|r| &r.scene == name).collect();
+        // The reference itself (error 0) has no place on a log axis; the tables give
+        // its time.
+        let these: Vec<&Row> = rows
+            .iter()
+            .filter(|r| &r.scene == name && r.errors.rmse > 0.0)
+            .collect();
         let pts: Vec<(f64, f64)> = these
             .iter()
-            .map(|r| (r.median_s * 1e3, r.errors.rmse.max(floor)))
+            .map(|r| (r.median_s * 1e3, r.errors.rmse))
             .collect();
         let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         for &(x, y) in &pts {
@@ -760,7 +810,7 @@ fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
         }
         let mut chart = ChartBuilder::on(panel)
             .caption(
-                format!("{name}: time against error (★ Pareto front)"),
+                format!("{name}: time against error, Pareto front in red"),
                 ("sans-serif", 18),
             )
             .margin(12)
@@ -773,6 +823,8 @@ fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
             .map_err(|x| e(&x))?;
         chart
             .configure_mesh()
+            .bold_line_style(grid_bold)
+            .light_line_style(grid_light)
             .x_desc("median render time (ms, log)")
             .y_desc("RMSE vs reference (8-bit levels, log)")
             .draw()
@@ -808,8 +860,13 @@ fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
             .map(|(_, &p)| p)
             .collect();
         front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // Segment by segment: some renderers fill a polyline's area despite fill="none".
         chart
-            .draw_series(LineSeries::new(front.clone(), RED.stroke_width(2)))
+            .draw_series(
+                front
+                    .windows(2)
+                    .map(|w| PathElement::new(vec![w[0], w[1]], RED.stroke_width(2))),
+            )
             .map_err(|x| e(&x))?;
         chart
             .draw_series(
@@ -839,19 +896,27 @@ fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
         ("f64", BLACK),
         ("preset", RED),
     ];
-    let (_, h) = root.dim_in_pixel();
     for (n, (label, color)) in legend.iter().enumerate() {
-        let x = 80 + 150 * n as i32;
-        let y = h as i32 - 14;
-        root.draw(&Circle::new((x, y), 5, color.filled()))
+        let x = 60 + 115 * n as i32;
+        let y = 18;
+        bottom
+            .draw(&Circle::new((x, y), 5, color.filled()))
             .map_err(|x| e(&x))?;
-        root.draw(&Text::new(
-            label.to_string(),
-            (x + 10, y - 7),
+        bottom
+            .draw(&Text::new(
+                label.to_string(),
+                (x + 10, y - 7),
+                ("sans-serif", 14),
+            ))
+            .map_err(|x| e(&x))?;
+    }
+    bottom
+        .draw(&Text::new(
+            "red rings and line: the Pareto front of each scene".to_string(),
+            (60 + 115 * legend.len() as i32, 11),
             ("sans-serif", 14),
         ))
         .map_err(|x| e(&x))?;
-    }
     root.present().map_err(|x| e(&x))?;
     Ok(())
 }

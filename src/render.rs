@@ -497,9 +497,11 @@ fn adaptive(
         let (ox, oy) = (ax + dx, ay + dy);
         let o = oy * ow + ox;
         let m = means[o];
-        let differs = |q: usize| (means[q] - m).abs().max_element() >= a.threshold;
-        // Refine unless everything is below the threshold (so threshold 0 refines all).
-        *flag = !(spread(&firsts[o * nf..(o + 1) * nf]) < a.threshold)
+        // Refine unless everything is surely below the threshold (so threshold 0, or
+        // a NaN anywhere, refines).
+        let reaches = |x: f32| x.partial_cmp(&a.threshold) != Some(std::cmp::Ordering::Less);
+        let differs = |q: usize| reaches((means[q] - m).abs().max_element());
+        *flag = reaches(spread(&firsts[o * nf..(o + 1) * nf]))
             || (ox > 0 && differs(o - 1))
             || (ox + 1 < ow && differs(o + 1))
             || (oy > 0 && differs(o - ow))

@@ -35,7 +35,6 @@ fn tiny_study_writes_a_complete_csv_table_and_plot() {
             row.iter().all(|c| !c.trim().is_empty()),
             "empty cell in {row:?}"
         );
-        assert_eq!(row[col("runs")].parse::<usize>().unwrap() >= 1, true);
         let median: f64 = row[col("median_s")].parse().unwrap();
         assert!(median > 0.0);
         let rmse: f64 = row[col("rmse_levels")].parse().unwrap();
@@ -63,11 +62,11 @@ fn tiny_study_writes_a_complete_csv_table_and_plot() {
             .find(|r| r[col("preset")] == "reference")
             .unwrap();
         assert_eq!(reference[col("rmse_levels")], "0.0000");
-        // Timed settings ran the asked number of times.
+        // Timed settings ran at least the asked number of times, at most ten times it.
         assert!(these
             .iter()
             .filter(|r| r[col("preset")] != "reference")
-            .all(|r| r[col("runs")] == "5"));
+            .all(|r| (5..=50).contains(&r[col("runs")].parse::<usize>().unwrap())));
     }
     // The cutoff setting reports a bound; the others none.
     assert!(body
