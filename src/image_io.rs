@@ -120,13 +120,33 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
         path: path.display().to_string(),
         message,
     };
+    // A target that exists and is not a regular file (a device such as /dev/full, a
+    // pipe) is written into directly: renaming over it would replace it.
+    if let Ok(meta) = std::fs::metadata(path) {
+        if meta.is_dir() {
+            return Err(err("is a folder".into()));
+        }
+        if !meta.is_file() {
+            let mut target = std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .map_err(|e| err(e.to_string()))?;
+            return target
+                .write_all(bytes)
+                .and_then(|()| target.flush())
+                .map_err(|e| err(e.to_string()));
+        }
+    }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut temp = tempfile::Builder::new()
-        .prefix(".whitted-")
-        .suffix(".part")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".whitted-").suffix(".part");
+    // Like any new file: 0666 less the umask, not the temporary file's private 0600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut temp = builder
         .tempfile_in(dir)
         .map_err(|e| err(format!("cannot create a file in {}: {e}", dir.display())))?;
     temp.write_all(bytes).map_err(|e| err(e.to_string()))?;
