@@ -140,3 +140,65 @@ fn size_option_parses_and_rejects_clearly() {
         assert!(e.contains("WxH") && e.contains(bad), "{e}");
     }
 }
+
+/// A row of a made-up scene "s" with the given setting, time and RMSE.
+fn row(spp: u32, threshold: Option<f32>, depth: u32, seconds: f64, rmse: f64) -> bench::Row {
+    use whitted::quality::{Adaptive, Quality};
+    bench::Row {
+        scene: "s".into(),
+        setting: bench::Setting {
+            quality: Quality {
+                spp,
+                adaptive: threshold.map(Adaptive::with_threshold),
+                max_depth: depth,
+                ..Quality::default()
+            },
+            preset: None,
+        },
+        runs: 5,
+        median_s: seconds,
+        min_s: seconds,
+        rays: 1,
+        refined: 1.0,
+        errors: bench::Errors {
+            rmse,
+            ..Default::default()
+        },
+        cutoff_bound: 0.0,
+        cutoff_error: 0,
+        pareto: true,
+    }
+}
+
+#[test]
+fn fixed_spp_time_interpolates_log_log_at_the_same_depth() {
+    let rows = vec![
+        row(1, None, 5, 1.0, 8.0),
+        row(4, None, 5, 4.0, 2.0),
+        // Another depth: not part of the depth-5 sweep.
+        row(4, None, 16, 100.0, 3.0),
+        // Adaptive: not a fixed-spp setting.
+        row(16, Some(0.1), 5, 2.0, 1.0),
+    ];
+    // RMSE 4 is halfway between 8 and 2 in log: time halfway between 1 and 4 in log.
+    let t = bench::fixed_spp_time_for(&rows, "s", 5, 4.0).unwrap();
+    assert!((t - 2.0).abs() < 1e-12, "{t}");
+    assert_eq!(bench::fixed_spp_time_for(&rows, "s", 5, 1.0), None);
+    assert_eq!(bench::fixed_spp_time_for(&rows, "s", 16, 3.0), None);
+}
+
+#[test]
+fn knee_is_the_front_point_farthest_below_the_scaled_chord() {
+    // Plain (1 spp, depth 5) at (1 s, RMSE 10); best RMSE 1 first reached at 10 s.
+    // Scaled: x = (t − 1)/9, y = (e − 1)/9; distance below the chord = 1 − x − y.
+    let rows = vec![
+        row(1, None, 5, 1.0, 10.0),
+        row(4, None, 5, 2.0, 6.0),       // 1 − 1/9 − 5/9 = 3/9
+        row(16, Some(0.1), 5, 3.0, 2.0), // 1 − 2/9 − 1/9 = 6/9: the knee
+        row(16, None, 5, 6.0, 1.5),      // 1 − 5/9 − 0.5/9 = 3.5/9
+        row(64, None, 5, 10.0, 1.0),
+        row(256, None, 5, 40.0, 0.95), // beyond the chord's end (within 10% of best)
+    ];
+    let k = bench::knee(&rows, "s").unwrap();
+    assert_eq!((k.median_s, k.errors.rmse), (3.0, 2.0));
+}
