@@ -11,8 +11,10 @@ use std::time::Instant;
 
 use glam::Vec3;
 
+use crate::camera::Camera;
 use crate::render::{self, Frame, RenderControl, RenderError, RenderOptions};
 use crate::scene::Scene;
+use crate::trace::fast::FastTracer;
 
 use super::buffer::{to_rgba_top_down, upscale};
 use super::schedule::{plan, Pass};
@@ -126,12 +128,13 @@ impl Drop for Worker {
 }
 
 fn serve(rx: Receiver<Job>, sink: impl Fn(Report)) {
+    let mut cache = TracerCache::default();
     while let Ok(mut job) = rx.recv() {
         // Only the newest queued view matters.
         while let Ok(newer) = rx.try_recv() {
             job = newer;
         }
-        match run(&job, &sink) {
+        match run(&job, &mut cache, &sink) {
             Ok(()) | Err(RenderError::Cancelled) => {}
             Err(RenderError::Invalid(message)) => sink(Report::Failed {
                 generation: job.generation,
@@ -141,8 +144,32 @@ fn serve(rx: Receiver<Job>, sink: impl Fn(Report)) {
     }
 }
 
+/// The last view's tracer: a new view of the same scene reuses its compiled scene and
+/// rebuilds only the camera's part (see `FastTracer::with_camera`).
+#[derive(Default)]
+pub struct TracerCache {
+    last: Option<(Arc<Scene>, FastTracer)>,
+}
+
+impl TracerCache {
+    fn tracer(
+        &mut self,
+        scene: &Arc<Scene>,
+        opts: &RenderOptions,
+    ) -> Result<&FastTracer, RenderError> {
+        let camera = Camera::for_scene(scene, opts.image.width, opts.image.height)
+            .map_err(|m| RenderError::Invalid(format!("camera: {m}")))?;
+        let depth = opts.image.max_depth;
+        let tracer = match self.last.take() {
+            Some((s, previous)) if Arc::ptr_eq(&s, scene) => previous.with_camera(&camera, depth),
+            _ => FastTracer::new(scene, &camera, depth),
+        };
+        Ok(&self.last.insert((Arc::clone(scene), tracer)).1)
+    }
+}
+
 /// Renders all passes of `job`, reporting each; stops early when cancelled.
-pub fn run(job: &Job, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
+pub fn run(job: &Job, cache: &mut TracerCache, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
     let scene = job.scene.as_ref();
     let control = job.control.as_ref();
     let mut opts = RenderOptions::for_scene(scene);
@@ -151,7 +178,7 @@ pub fn run(job: &Job, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
     opts.check()?;
     let (w, h) = (job.width, job.height);
     let target = opts.image.spp;
-    let tracer = render::make_tracer(scene, &opts)?;
+    let tracer = cache.tracer(&job.scene, &opts)?;
     let mut sums = vec![Vec3::ZERO; w as usize * h as usize];
     let passes = plan(w, h, target, job.preview_factor);
     let last = passes.len() - 1;
@@ -173,7 +200,7 @@ pub fn run(job: &Job, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
                 small.image.height = height;
                 small.image.spp = 1;
                 let mut preview_sums = vec![Vec3::ZERO; width as usize * height as usize];
-                render::accumulate(tracer.as_ref(), &small, 0..1, &mut preview_sums, control)?;
+                render::accumulate(tracer, &small, 0..1, &mut preview_sums, control)?;
                 let preview = render::resolve(&preview_sums, 1, width, height);
                 let pixels = u64::from(width) * u64::from(height);
                 (upscale(&preview, factor, w, h), 0, true, pixels)
@@ -181,7 +208,7 @@ pub fn run(job: &Job, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
             Pass::Samples(range) => {
                 let end = range.end;
                 let pixels = u64::from(w) * u64::from(h) * range.len() as u64;
-                render::accumulate(tracer.as_ref(), &opts, range, &mut sums, control)?;
+                render::accumulate(tracer, &opts, range, &mut sums, control)?;
                 (render::resolve(&sums, end, w, h), end, false, pixels)
             }
         };
@@ -227,7 +254,7 @@ mod tests {
             control: Arc::new(RenderControl::default()),
             submitted: Instant::now(),
         };
-        run(&job, &sink).unwrap();
+        run(&job, &mut TracerCache::default(), &sink).unwrap();
         let v = shown.lock().unwrap().clone();
         v
     }
