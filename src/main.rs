@@ -115,7 +115,8 @@ struct BenchArgs {
     /// Image size of every render.
     #[arg(long, value_name = "WxH", default_value = "320x180", value_parser = bench::parse_size)]
     size: (u32, u32),
-    /// Timed runs per setting (the median is reported).
+    /// Timed runs per setting, at least (the median is reported; settings that take
+    /// milliseconds get up to 10 times as many).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     runs: u32,
     /// A tiny grid on small scenes, for a quick check.
