@@ -4,6 +4,7 @@
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use glam::Vec3;
@@ -249,12 +250,25 @@ where
     };
     match opts.threads {
         None => work(),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| RenderError::Invalid(format!("cannot start {n} threads: {e}")))?
-            .install(work),
+        Some(n) => thread_pool(n)?.install(work),
     }
+}
+
+/// A pool of `n` worker threads, started once per process and reused: starting threads
+/// for every render (every frame of the viewer) would cost more than small renders.
+fn thread_pool(n: usize) -> Result<Arc<rayon::ThreadPool>, RenderError> {
+    static POOLS: Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
+    let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, pool)) = pools.iter().find(|(size, _)| *size == n) {
+        return Ok(Arc::clone(pool));
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map_err(|e| RenderError::Invalid(format!("cannot start {n} threads: {e}")))?;
+    let pool = Arc::new(pool);
+    pools.push((n, Arc::clone(&pool)));
+    Ok(pool)
 }
 
 /// The film position of sample `k` of pixel `(i, j)`.
@@ -374,9 +388,12 @@ pub fn render_bounded(
                     }
                 },
             )?;
-            let sums: Vec<Vec3> = acc.iter().map(|p| p.0).collect();
+            let frame = Frame {
+                width: area.width,
+                height: area.height,
+                pixels: acc.iter().map(|p| pixel_value(p.0, spp)).collect(),
+            };
             let bounds = acc.iter().map(|p| p.1 / spp as f32).collect();
-            let frame = resolve(&sums, spp, area.width, area.height);
             (frame, bounds, acc.len() as u64, rays)
         }
     };
