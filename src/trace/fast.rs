@@ -61,8 +61,9 @@ struct Skipped {
 impl FastTracer {
     pub fn new(scene: &Scene, camera: &Camera, max_depth: u32) -> Self {
         let lights: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
+        let (spheres, eye) = Spheres::build_for_view(&scene.spheres, &lights, camera.origin);
         let compiled = Compiled {
-            spheres: Spheres::new(&scene.spheres).with_light_grids(&lights),
+            spheres,
             materials: scene
                 .spheres
                 .iter()
@@ -86,12 +87,17 @@ impl FastTracer {
             sky_up: scene.sky.up.as_vec3(),
             value_bound: value_bound(scene),
         };
-        Self::with_compiled(Arc::new(compiled), camera, max_depth)
+        Self::with_compiled(Arc::new(compiled), eye, camera, max_depth)
     }
 
-    fn with_compiled(compiled: Arc<Compiled>, camera: &Camera, max_depth: u32) -> Self {
+    fn with_compiled(
+        compiled: Arc<Compiled>,
+        eye: EyeGrid,
+        camera: &Camera,
+        max_depth: u32,
+    ) -> Self {
         FastTracer {
-            eye: compiled.spheres.eye_grid(camera.origin),
+            eye,
             compiled,
             origin: camera.origin,
             corner: (camera.lower_left - camera.origin).as_vec3(),
@@ -105,7 +111,9 @@ impl FastTracer {
     /// The same scene seen by another camera (and depth): shares the compiled scene and
     /// rebuilds only the camera's grid, so views of one scene compile it once.
     pub fn with_camera(&self, camera: &Camera, max_depth: u32) -> Self {
-        Self::with_compiled(Arc::clone(&self.compiled), camera, max_depth).with_cutoff(self.cutoff)
+        let eye = self.compiled.spheres.eye_grid(camera.origin);
+        Self::with_compiled(Arc::clone(&self.compiled), eye, camera, max_depth)
+            .with_cutoff(self.cutoff)
     }
 
     /// Skip every branch whose path weight (the product of the mix weights of step 7
