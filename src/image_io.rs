@@ -113,22 +113,61 @@ pub fn encode_rgb8(image: &RgbImage, format: Format, out: &mut dyn Write) -> Res
     result.map_err(|e| e.to_string())
 }
 
+/// The folder a file at `path` goes into (`.` for a bare file name).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// A temporary file beside `path`, where [`write_atomically`] puts the bytes first.
+fn temp_file_for(path: &Path) -> Result<tempfile::NamedTempFile, SaveError> {
+    let dir = folder_of(path);
+    let err = |message: String| SaveError {
+        path: path.display().to_string(),
+        message,
+    };
+    match std::fs::metadata(dir) {
+        Err(e) => return Err(err(format!("cannot use the folder {}: {e}", dir.display()))),
+        Ok(m) if !m.is_dir() => {
+            return Err(err(format!("{} is not a folder", dir.display())));
+        }
+        Ok(_) => {}
+    }
+    tempfile::Builder::new()
+        .prefix(".whitted-")
+        .suffix(".part")
+        .tempfile_in(dir)
+        .map_err(|e| {
+            // tempfile appends the random name it tried, which means nothing to the user.
+            let text = e.to_string();
+            let reason = text.split(" at path ").next().unwrap_or(&text);
+            err(format!("cannot write into {}: {reason}", dir.display()))
+        })
+}
+
+/// Fails unless a file can be created in the folder of `path`: lets a command refuse
+/// an unwritable target before it spends time rendering. Leaves nothing behind.
+pub fn check_writable(path: &Path) -> Result<(), SaveError> {
+    if path.is_dir() {
+        return Err(SaveError {
+            path: path.display().to_string(),
+            message: "is a folder".into(),
+        });
+    }
+    temp_file_for(path).map(drop)
+}
+
 /// Writes `bytes` into `path` atomically: a temporary file in the same folder, flushed
-/// and synced, then renamed over the target. On any error nothing is left behind.
+/// and synced, then renamed over the target. On any error nothing is left behind (the
+/// temporary file deletes itself when dropped).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
     let err = |message: String| SaveError {
         path: path.display().to_string(),
         message,
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut temp = tempfile::Builder::new()
-        .prefix(".whitted-")
-        .suffix(".part")
-        .tempfile_in(dir)
-        .map_err(|e| err(format!("cannot create a file in {}: {e}", dir.display())))?;
+    let mut temp = temp_file_for(path)?;
     temp.write_all(bytes).map_err(|e| err(e.to_string()))?;
     temp.as_file().sync_all().map_err(|e| err(e.to_string()))?;
     temp.persist(path).map_err(|e| err(e.error.to_string()))?;

@@ -51,7 +51,7 @@ struct RenderArgs {
     scene: Option<PathBuf>,
     /// Output file, format by extension: .ppm .png .bmp .jpg .exr (repeatable).
     /// Default: output.ppm and output.png.
-    #[arg(short, long = "output", value_name = "FILE")]
+    #[arg(short, long = "output", value_name = "FILE", value_parser = parse_output)]
     output: Vec<PathBuf>,
     /// Write binary PPM (P6) instead of plain (P3).
     #[arg(long)]
@@ -97,6 +97,24 @@ fn parse_region(text: &str) -> Result<Region, String> {
     }
 }
 
+/// An output path whose extension names a format we write (else a usage error).
+fn parse_output(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    Format::from_path(&path, false)?;
+    Ok(path)
+}
+
+/// The built-in scene, embedded from the file the generator wrote
+/// (`whitted scene hw3 > assets/scenes/hw3.toml`); a test keeps the two in step.
+const BUILTIN_SCENE: &str = include_str!("../assets/scenes/hw3.toml");
+
+fn builtin_scene() -> anyhow::Result<Scene> {
+    let mut scene = Scene::from_toml_str(BUILTIN_SCENE, "assets/scenes/hw3.toml")
+        .context("the built-in scene is broken")?;
+    scene.name = "hw3".into();
+    Ok(scene)
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -135,7 +153,7 @@ fn one_line(e: &anyhow::Error) -> String {
 
 fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
     match path {
-        None => Ok(scene::hw3_scene(scene::HW3_DEFAULT_SEED)),
+        None => builtin_scene(),
         Some(p) => Ok(Scene::load(p)?),
     }
 }
@@ -146,21 +164,18 @@ fn view(path: Option<&Path>) -> anyhow::Result<()> {
 }
 
 fn render_command(args: RenderArgs) -> anyhow::Result<()> {
-    // Output formats first: a bad extension is a usage error, found before any work.
     let outputs: Vec<PathBuf> = if args.output.is_empty() {
         vec!["output.ppm".into(), "output.png".into()]
     } else {
         args.output.clone()
     };
     let mut targets = Vec::new();
-    for path in &outputs {
-        match Format::from_path(path, args.ppm_binary) {
-            Ok(format) => targets.push((path.clone(), format)),
-            Err(message) => {
-                eprintln!("whitted: error: {message}");
-                std::process::exit(2);
-            }
-        }
+    for path in outputs {
+        // clap's parser has vetted every extension.
+        let format = Format::from_path(&path, args.ppm_binary).map_err(|m| anyhow!(m))?;
+        // A folder we cannot write into fails now, not after a long render.
+        image_io::check_writable(&path)?;
+        targets.push((path, format));
     }
 
     let scene = load_scene(args.scene.as_deref())?;
