@@ -144,7 +144,7 @@ impl<'a> ReferenceTracer<'a> {
                 if cos > 0.0 {
                     counts.shadow += 1;
                     let shadow = self.shadow(&spawn(l, !front), dist);
-                    local = local + model::diffuse(s.color, light.intensity, cos, shadow);
+                    local += model::diffuse(s.color, light.intensity, cos, shadow);
                 }
             }
         }
