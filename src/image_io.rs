@@ -135,16 +135,21 @@ fn temp_file_for(path: &Path) -> Result<tempfile::NamedTempFile, SaveError> {
         }
         Ok(_) => {}
     }
-    tempfile::Builder::new()
-        .prefix(".whitted-")
-        .suffix(".part")
-        .tempfile_in(dir)
-        .map_err(|e| {
-            // tempfile appends the random name it tried, which means nothing to the user.
-            let text = e.to_string();
-            let reason = text.split(" at path ").next().unwrap_or(&text);
-            err(format!("cannot write into {}: {reason}", dir.display()))
-        })
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".whitted-").suffix(".part");
+    // tempfile makes private (0600) files; an image is an ordinary file, readable as
+    // the user's umask allows, like any file a program creates.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir).map_err(|e| {
+        // tempfile appends the random name it tried, which means nothing to the user.
+        let text = e.to_string();
+        let reason = text.split(" at path ").next().unwrap_or(&text);
+        err(format!("cannot write into {}: {reason}", dir.display()))
+    })
 }
 
 /// Fails unless a file can be created in the folder of `path`: lets a command refuse

@@ -143,6 +143,32 @@ fn every_format_decodes_to_the_rendered_image() {
         frame.get(W - 1, 0).to_array()
     );
 
+    // Written files are ordinary files: the mode any program's new file gets under
+    // this umask (not the private 0600 of a temporary file).
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let reference = dir.path().join("plain-file");
+        std::fs::write(&reference, b"").unwrap();
+        let mode = |f: &str| std::fs::metadata(f).unwrap().permissions().mode() & 0o777;
+        let expected_mode = mode(reference.to_str().unwrap());
+        for name in [
+            "plain.ppm",
+            "binary.ppm",
+            "a.png",
+            "a.bmp",
+            "a.jpg",
+            "a.exr",
+        ] {
+            assert_eq!(
+                mode(&p(name)),
+                expected_mode,
+                "{name}: mode {:o}",
+                mode(&p(name))
+            );
+        }
+        std::fs::remove_file(reference).unwrap();
+    }
+
     // Nothing else was left in the folder (no temporary files).
     let mut names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
