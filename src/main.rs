@@ -56,8 +56,10 @@ struct RenderArgs {
     /// Write binary PPM (P6) instead of plain (P3).
     #[arg(long)]
     ppm_binary: bool,
+    /// Image width in pixels (overrides the scene's).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     width: Option<u32>,
+    /// Image height in pixels (overrides the scene's).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     height: Option<u32>,
     /// Samples per pixel.
