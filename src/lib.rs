@@ -16,6 +16,7 @@ pub mod model;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod speed;
 pub mod trace;
 pub mod viewer;
 

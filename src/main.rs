@@ -34,6 +34,18 @@ enum Command {
     },
     /// Render without a window and write image files.
     Render(RenderArgs),
+    /// Time renders of a scene (median of several runs) and print a line in the form
+    /// of the peer programs' results (`../shared/peers/run.sh`).
+    Time {
+        /// A scene file (TOML); default: the built-in hw3 scene.
+        scene: Option<PathBuf>,
+        /// Timed runs (after one warm-up).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Worker threads (default: all cores).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+        threads: Option<u32>,
+    },
     /// Print a built-in scene as a scene file.
     Scene {
         /// The built-in scene: only "hw3".
@@ -130,6 +142,11 @@ fn main() -> ExitCode {
         None => view(None),
         Some(Command::View { scene }) => view(scene.as_deref()),
         Some(Command::Render(args)) => render_command(args),
+        Some(Command::Time {
+            scene,
+            runs,
+            threads,
+        }) => time_command(scene.as_deref(), runs, threads),
         Some(Command::Scene { name: _, seed }) => {
             print!("{}", scene::hw3_toml(seed));
             Ok(())
@@ -163,6 +180,16 @@ fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
 fn view(path: Option<&Path>) -> anyhow::Result<()> {
     let scene = load_scene(path)?;
     whitted::viewer::run(scene)
+}
+
+fn time_command(path: Option<&Path>, runs: usize, threads: Option<u32>) -> anyhow::Result<()> {
+    let scene = load_scene(path)?;
+    let mut opts = RenderOptions::for_scene(&scene);
+    opts.threads = threads.map(|t| t as usize);
+    let timing = whitted::speed::time_render(&scene, &opts, runs)?;
+    let name = path.map_or("hw3".to_string(), |p| p.display().to_string());
+    println!("{}", timing.result_line(&name, &opts, scene.spheres.len()));
+    Ok(())
 }
 
 fn render_command(args: RenderArgs) -> anyhow::Result<()> {

@@ -168,10 +168,11 @@ impl Branches {
 }
 
 /// The primary ray direction through film position `(s, t)` ∈ [0,1]²:
-/// `normalize(LL + s·H + t·V − O)`.
+/// `normalize(LL + s·H + t·V − O)`, given `corner = LL − O` (computed once, in `f64`,
+/// so that a camera far from the world's origin loses nothing to cancellation).
 #[inline]
-pub fn primary_direction<V: Vector>(origin: V, lower_left: V, h: V, v: V, s: V::R, t: V::R) -> V {
-    (((lower_left + h * s) + v * t) - origin).normalize()
+pub fn primary_direction<V: Vector>(corner: V, h: V, v: V, s: V::R, t: V::R) -> V {
+    ((corner + h * s) + v * t).normalize()
 }
 
 /// Which way a spawned ray leaves the sphere it starts on. An outward ray cannot meet

@@ -144,7 +144,10 @@ impl Frame {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderStats {
     pub rays: RayCounts,
+    /// Wall time of the whole render, preparation included.
     pub seconds: f64,
+    /// Of which: compiling the scene for the tracer (acceleration structures).
+    pub build_seconds: f64,
 }
 
 impl RenderStats {
@@ -265,6 +268,7 @@ pub fn render(
     opts.check()?;
     let start = Instant::now();
     let tracer = make_tracer(scene, opts)?;
+    let build_seconds = start.elapsed().as_secs_f64();
     let area = opts.area();
     let mut sums = vec![Vec3::ZERO; area.width as usize * area.height as usize];
     let rays = accumulate(tracer.as_ref(), opts, 0..opts.image.spp, &mut sums, control)?;
@@ -272,6 +276,7 @@ pub fn render(
     let stats = RenderStats {
         rays,
         seconds: start.elapsed().as_secs_f64(),
+        build_seconds,
     };
     Ok((frame, stats))
 }

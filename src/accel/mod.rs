@@ -2,7 +2,14 @@
 //! the layout the queries want. Every query answers exactly what a test of every
 //! sphere would answer; only the work to get there differs.
 
-use glam::{DVec3, Vec3};
+mod bvh;
+mod dirgrid;
+
+use glam::{DVec3, Vec3, Vec4};
+use rayon::prelude::*;
+
+use bvh::{Aabb, Bvh};
+use dirgrid::DirGrid;
 
 use crate::model::Side;
 use crate::scene::Sphere;
@@ -20,24 +27,63 @@ pub struct Hit {
     pub entering: bool,
 }
 
-/// A ray as the queries see it: `f32` origin and unit direction, and the sphere it was
-/// spawned on with the way it leaves it.
+/// A ray as the queries see it: origin (in `f64`: a spawn point keeps the precision of
+/// its re-projection onto its sphere), unit direction, and the sphere it was spawned on
+/// with the way it leaves it.
 #[derive(Clone, Copy, Debug)]
 pub struct Query {
-    pub origin: Vec3,
+    pub origin: DVec3,
     pub dir: Vec3,
     pub from: Option<(u32, Side)>,
 }
 
 impl Query {
     /// Crossings of other spheres closer than this are lost in the rounding of the
-    /// spawn point's `f32` coordinates and ignored.
+    /// spawn point's coordinates and ignored.
     #[inline]
     pub fn t_min(&self) -> f64 {
         match self.from {
             None => 0.0,
-            Some(_) => 4.0 * f64::from(f32::EPSILON) * f64::from(self.origin.abs().max_element()),
+            Some(_) => 16.0 * f64::EPSILON * self.origin.abs().max_element(),
         }
+    }
+}
+
+/// A query with what every sphere test needs, computed once.
+#[derive(Clone, Copy)]
+struct Ray {
+    o64: DVec3,
+    /// The direction renormalised in `f64`: the exact tests assume `d·d = 1`, which an
+    /// `f32`-normalised direction misses by up to ~1e-7.
+    d64: DVec3,
+    d32: Vec3,
+    from: Option<(u32, Side)>,
+    t_min: f64,
+}
+
+impl Ray {
+    #[inline]
+    fn new(q: &Query) -> Ray {
+        Ray {
+            o64: q.origin,
+            d64: q.dir.as_dvec3().normalize(),
+            d32: q.dir,
+            from: q.from,
+            t_min: q.t_min(),
+        }
+    }
+}
+
+/// Relative slack of the `f32` quick reject: many times its rounding error, so that it
+/// never rejects a sphere the exact `f64` test would hit.
+const QUICK_SLACK: f32 = 1.0 / (1 << 18) as f32;
+
+/// Cells per face of the directional grids.
+fn grid_resolution(spheres: usize) -> u32 {
+    if spheres <= 4096 {
+        128
+    } else {
+        256
     }
 }
 
@@ -45,13 +91,91 @@ impl Query {
 pub struct Spheres {
     center: Vec<DVec3>,
     radius: Vec<f64>,
+    /// `f32` centre and radius, the radius widened to cover the centre's rounding.
+    quick: Vec<Vec4>,
+    bvh: Bvh,
+    /// Around the camera origin, for primary rays.
+    eye: Option<DirGrid>,
+    /// Around each light, for shadow rays.
+    lights: Vec<DirGrid>,
 }
 
 impl Spheres {
+    /// The spheres with a hierarchy for rays of any origin.
     pub fn new(spheres: &[Sphere]) -> Self {
+        let center: Vec<DVec3> = spheres.iter().map(|s| s.center).collect();
+        let radius: Vec<f64> = spheres.iter().map(|s| s.radius).collect();
+        let quick = center
+            .iter()
+            .zip(&radius)
+            .map(|(&c, &r)| {
+                let widen = 4.0 * f64::from(f32::EPSILON) * (c.abs().max_element() + r);
+                c.as_vec3().extend((r + widen) as f32)
+            })
+            .collect();
+        let boxes: Vec<Aabb> = center
+            .iter()
+            .zip(&radius)
+            .map(|(&c, &r)| {
+                let widen = r * 1e-6 + 1e-6 * c.abs().max_element();
+                let (lo, hi) = (c - DVec3::splat(r + widen), c + DVec3::splat(r + widen));
+                // Round outwards to f32.
+                let down = |x: f64| {
+                    let f = x as f32;
+                    if f64::from(f) > x {
+                        f.next_down()
+                    } else {
+                        f
+                    }
+                };
+                let up = |x: f64| {
+                    let f = x as f32;
+                    if f64::from(f) < x {
+                        f.next_up()
+                    } else {
+                        f
+                    }
+                };
+                Aabb {
+                    min: Vec3::new(down(lo.x), down(lo.y), down(lo.z)),
+                    max: Vec3::new(up(hi.x), up(hi.y), up(hi.z)),
+                }
+            })
+            .collect();
         Spheres {
-            center: spheres.iter().map(|s| s.center).collect(),
-            radius: spheres.iter().map(|s| s.radius).collect(),
+            bvh: Bvh::build(&boxes),
+            center,
+            radius,
+            quick,
+            eye: None,
+            lights: Vec::new(),
+        }
+    }
+
+    /// Adds directional grids around the camera origin and each light, so primary and
+    /// shadow rays test only the spheres seen in their direction.
+    pub fn with_grids(mut self, eye: DVec3, lights: &[DVec3]) -> Self {
+        let list: Vec<(DVec3, f64)> = self
+            .center
+            .iter()
+            .copied()
+            .zip(self.radius.iter().copied())
+            .collect();
+        let n = grid_resolution(list.len());
+        // All grids at once: they are independent.
+        let points: Vec<DVec3> = std::iter::once(eye).chain(lights.iter().copied()).collect();
+        let mut grids: Vec<DirGrid> = points
+            .par_iter()
+            .map(|&p| DirGrid::build(p, &list, n))
+            .collect();
+        self.lights = grids.split_off(1);
+        self.eye = grids.pop();
+        self
+    }
+
+    pub fn debug_stats(&self) {
+        for g in self.eye.iter().chain(&self.lights) {
+            g.debug_stats();
         }
     }
 
@@ -63,19 +187,36 @@ impl Spheres {
         self.center.is_empty()
     }
 
+    /// `false` when sphere `k` certainly has no crossing in `(0, t_max)` (cheap, `f32`
+    /// after one `f64` subtraction, which keeps origins far from the world's origin exact
+    /// enough).
+    #[inline(always)]
+    fn may_cross(&self, k: usize, ray: &Ray, t_max: f32) -> bool {
+        let s = self.quick[k];
+        let f = (ray.o64 - self.center[k]).as_vec3();
+        let d = ray.d32;
+        let bp = -f.dot(d);
+        let l = f + d * bp;
+        let rr = s.w * s.w;
+        let ff = f.dot(f);
+        let slack = QUICK_SLACK * (rr + ff);
+        if l.dot(l) > rr + slack {
+            return false;
+        }
+        // The crossings lie in [bp − r, bp + r], up to rounding.
+        let reach = s.w + QUICK_SLACK * (ff.sqrt() + s.w);
+        bp + reach > 0.0 && bp - reach < t_max
+    }
+
     /// The first crossing of sphere `k` in `(t_min, t_max)`: `(t, entering, normal)`.
     #[inline]
-    fn crossing(
-        &self,
-        k: usize,
-        o: DVec3,
-        d: DVec3,
-        from: Option<(u32, Side)>,
-        t_min: f64,
-        t_max: f64,
-    ) -> Option<(f64, bool, DVec3)> {
+    fn crossing(&self, k: usize, ray: &Ray, t_max: f64) -> Option<(f64, bool, DVec3)> {
+        let (o, d, t_min) = (ray.o64, ray.d64, ray.t_min);
         let (c, r) = (self.center[k], self.radius[k]);
-        let own = from.filter(|&(s, _)| s as usize == k).map(|(_, side)| side);
+        let own = ray
+            .from
+            .filter(|&(s, _)| s as usize == k)
+            .map(|(_, side)| side);
         if own == Some(Side::Outward) {
             return None;
         }
@@ -92,39 +233,139 @@ impl Spheres {
         }
     }
 
-    pub fn closest(&self, q: &Query) -> Option<Hit> {
-        let (o, d) = (q.origin.as_dvec3(), q.dir.as_dvec3());
-        let t_min = q.t_min();
-        let mut best: Option<(f64, usize, bool, DVec3)> = None;
-        for k in 0..self.len() {
-            let t_max = best.map_or(f64::INFINITY, |b| b.0);
-            if let Some((t, entering, normal)) = self.crossing(k, o, d, q.from, t_min, t_max) {
-                best = Some((t, k, entering, normal));
-            }
+    /// Tests sphere `k` for the closest hit so far; returns the new `t` if it is closer.
+    #[inline(always)]
+    fn consider(&self, k: u32, ray: &Ray, best: &mut Best) -> Option<f32> {
+        let k = k as usize;
+        let own_outward = ray.from == Some((k as u32, Side::Outward));
+        if own_outward || !self.may_cross(k, ray, round_up(best.t)) {
+            return None;
         }
-        let (_, k, entering, normal) = best?;
-        let normal = normal.normalize();
-        Some(Hit {
-            sphere: k as u32,
-            point: self.center[k] + normal * self.radius[k],
-            normal,
+        let (t, entering, normal) = self.crossing(k, ray, best.t)?;
+        *best = Best {
+            t,
+            k,
             entering,
+            normal,
+        };
+        Some(round_up(t))
+    }
+
+    fn finish(&self, best: Best) -> Option<Hit> {
+        if best.k == usize::MAX {
+            return None;
+        }
+        let normal = best.normal.normalize();
+        Some(Hit {
+            sphere: best.k as u32,
+            point: self.center[best.k] + normal * self.radius[best.k],
+            normal,
+            entering: best.entering,
         })
+    }
+
+    /// The closest hit of a ray of any origin.
+    pub fn closest(&self, q: &Query) -> Option<Hit> {
+        let ray = Ray::new(q);
+        let mut best = Best::NONE;
+        self.bvh
+            .traverse(q.origin.as_vec3(), q.dir.recip(), f32::INFINITY, |k| {
+                self.consider(k, &ray, &mut best)
+            });
+        self.finish(best)
+    }
+
+    /// The closest hit of a primary ray (its origin is the camera's).
+    pub fn closest_primary(&self, q: &Query) -> Option<Hit> {
+        let Some(grid) = self.eye.as_ref().filter(|g| g.centre == q.origin) else {
+            return self.closest(q);
+        };
+        let ray = Ray::new(q);
+        let mut best = Best::NONE;
+        for &k in &grid.always {
+            self.consider(k, &ray, &mut best);
+        }
+        let (items, near) = grid.candidates(grid.cell(q.dir));
+        for (&k, &near) in items.iter().zip(near) {
+            if f64::from(near) >= best.t {
+                break; // the rest are all farther
+            }
+            self.consider(k, &ray, &mut best);
+        }
+        self.finish(best)
+    }
+
+    /// Lowers `factor` by sphere `k`'s occlusion of the shadow segment.
+    #[inline(always)]
+    fn occlude(&self, k: u32, ray: &Ray, dist: f64, factor: &mut f32) {
+        let k = k as usize;
+        if ray.from == Some((k as u32, Side::Outward)) || !self.may_cross(k, ray, round_up(dist)) {
+            return;
+        }
+        if let Some((_, _, n_k)) = self.crossing(k, ray, dist) {
+            *factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
+        }
     }
 
     /// The shadow factor along the segment of length `dist` (step 4 of the model).
     pub fn shadow(&self, q: &Query, dist: f64) -> f32 {
-        let (o, d) = (q.origin.as_dvec3(), q.dir.as_dvec3());
-        let t_min = q.t_min();
+        let ray = Ray::new(q);
         let mut factor = 1.0f32;
-        for k in 0..self.len() {
-            if let Some((_, _, n_k)) = self.crossing(k, o, d, q.from, t_min, dist) {
-                factor = factor.min(crate::model::occluder_factor(q.dir, n_k.as_vec3()));
-                if factor <= 0.0 {
-                    break;
-                }
+        self.bvh
+            .traverse(q.origin.as_vec3(), q.dir.recip(), round_up(dist), |k| {
+                self.occlude(k, &ray, dist, &mut factor);
+                // A factor of 0 cannot go lower: stop looking.
+                (factor <= 0.0).then_some(-1.0)
+            });
+        factor
+    }
+
+    /// The shadow factor along the segment of length `dist` towards light `light`.
+    pub fn shadow_to_light(&self, q: &Query, dist: f64, light: usize) -> f32 {
+        let Some(grid) = self.lights.get(light) else {
+            return self.shadow(q, dist);
+        };
+        let ray = Ray::new(q);
+        let mut factor = 1.0f32;
+        for &k in &grid.always {
+            self.occlude(k, &ray, dist, &mut factor);
+        }
+        let (items, near) = grid.candidates(grid.cell((q.origin - grid.centre).as_vec3()));
+        for (&k, &near) in items.iter().zip(near) {
+            if f64::from(near) >= dist || factor <= 0.0 {
+                break; // beyond the hit point, seen from the light
             }
+            self.occlude(k, &ray, dist, &mut factor);
         }
         factor
+    }
+}
+
+/// The closest crossing found so far.
+#[derive(Clone, Copy)]
+struct Best {
+    t: f64,
+    k: usize,
+    entering: bool,
+    normal: DVec3,
+}
+
+impl Best {
+    const NONE: Best = Best {
+        t: f64::INFINITY,
+        k: usize::MAX,
+        entering: false,
+        normal: DVec3::ZERO,
+    };
+}
+
+/// `t` as an `f32` no smaller than it.
+#[inline(always)]
+fn round_up(t: f64) -> f32 {
+    let f = t as f32;
+    if f64::from(f) < t {
+        f.next_up()
+    } else {
+        f
     }
 }

@@ -2,7 +2,7 @@
 //! scene compiled once ([`crate::accel`]) and the intersection maths in `f64` where
 //! `f32` cannot hold.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use super::{RayCounts, SampleTracer};
 use crate::accel::{Query, Spheres};
@@ -21,7 +21,7 @@ struct Material {
 
 #[derive(Clone, Copy)]
 struct Light {
-    position: Vec3,
+    position: DVec3,
     intensity: Vec3,
 }
 
@@ -31,17 +31,32 @@ pub struct FastTracer {
     lights: Vec<Light>,
     sky_down: Vec3,
     sky_up: Vec3,
-    origin: Vec3,
-    lower_left: Vec3,
+    origin: DVec3,
+    /// `LL − O`, rounded once from `f64`.
+    corner: Vec3,
     horizontal: Vec3,
     vertical: Vec3,
     max_depth: u32,
+    /// Contribution cutoff: a branch whose path weight is below it is not traced.
+    cutoff: f32,
+    /// An upper bound of any traced colour component (SPEC §2 colours are convex mixes
+    /// of sky colours and light sums), to turn skipped weight into an error bound.
+    value_bound: f32,
+}
+
+/// What a sample skipped under the contribution cutoff.
+#[derive(Clone, Copy, Debug, Default)]
+struct Skipped {
+    weight: f32,
 }
 
 impl FastTracer {
     pub fn new(scene: &Scene, camera: &Camera, max_depth: u32) -> Self {
         FastTracer {
-            spheres: Spheres::new(&scene.spheres),
+            spheres: Spheres::new(&scene.spheres).with_grids(
+                camera.origin,
+                &scene.lights.iter().map(|l| l.position).collect::<Vec<_>>(),
+            ),
             materials: scene
                 .spheres
                 .iter()
@@ -57,21 +72,50 @@ impl FastTracer {
                 .lights
                 .iter()
                 .map(|l| Light {
-                    position: l.position.as_vec3(),
+                    position: l.position,
                     intensity: l.intensity.as_vec3(),
                 })
                 .collect(),
             sky_down: scene.sky.down.as_vec3(),
             sky_up: scene.sky.up.as_vec3(),
-            origin: camera.origin.as_vec3(),
-            lower_left: camera.lower_left.as_vec3(),
+            origin: camera.origin,
+            corner: (camera.lower_left - camera.origin).as_vec3(),
             horizontal: camera.horizontal.as_vec3(),
             vertical: camera.vertical.as_vec3(),
             max_depth,
+            cutoff: 0.0,
+            value_bound: value_bound(scene),
         }
     }
 
-    fn trace(&self, ray: &Query, depth: u32, counts: &mut RayCounts) -> Vec3 {
+    /// Skip every branch whose path weight (the product of the mix weights of step 7
+    /// down to it) is below `cutoff`; 0 traces everything (exact).
+    pub fn with_cutoff(mut self, cutoff: f32) -> Self {
+        self.cutoff = cutoff.max(0.0);
+        self
+    }
+
+    /// Whether a branch of path weight `w` is traced; if not, its weight is recorded.
+    #[inline]
+    fn keep(&self, w: f32, skipped: &mut Skipped) -> bool {
+        if w == 0.0 {
+            return false;
+        }
+        if w < self.cutoff {
+            skipped.weight += w;
+            return false;
+        }
+        true
+    }
+
+    fn trace(
+        &self,
+        ray: &Query,
+        depth: u32,
+        weight: f32,
+        counts: &mut RayCounts,
+        skipped: &mut Skipped,
+    ) -> Vec3 {
         if depth >= self.max_depth {
             return model::sky(ray.dir, self.sky_down, self.sky_up);
         }
@@ -80,44 +124,57 @@ impl FastTracer {
         } else {
             counts.secondary += 1;
         }
-        let Some(hit) = self.spheres.closest(ray) else {
+        let hit = if depth == 0 {
+            self.spheres.closest_primary(ray)
+        } else {
+            self.spheres.closest(ray)
+        };
+        let Some(hit) = hit else {
             return model::sky(ray.dir, self.sky_down, self.sky_up);
         };
         let m = &self.materials[hit.sphere as usize];
         let front = hit.entering;
         let n = hit.normal.as_vec3();
         let nf = if front { n } else { -n };
-        let point = hit.point.as_vec3();
         let spawn = |dir: Vec3, inside: bool| Query {
-            origin: point,
+            origin: hit.point,
             dir,
             from: Some((hit.sphere, Side::inside(inside))),
         };
 
         let mut local = Vec3::ZERO;
-        if m.branches.local {
-            for light in &self.lights {
-                // The light direction from the f64 point: the f32 one may sit off the sphere.
-                let to_light = light.position.as_dvec3() - hit.point;
+        let w_local = weight * (1.0 - m.w_t) * (1.0 - m.w_r);
+        if m.branches.local && self.keep(w_local, skipped) {
+            for (index, light) in self.lights.iter().enumerate() {
+                // From the f64 point, which lies on the sphere.
+                let to_light = light.position - hit.point;
                 let dist = to_light.length();
                 let l = (to_light / dist).as_vec3();
                 let cos = nf.dot(l);
                 if cos > 0.0 {
                     counts.shadow += 1;
-                    let shadow = self.spheres.shadow(&spawn(l, !front), dist);
+                    let shadow = self.spheres.shadow_to_light(&spawn(l, !front), dist, index);
                     local += model::diffuse(m.color, light.intensity, cos, shadow);
                 }
             }
         }
-        let reflected = if m.branches.reflect {
+        let w_reflect = weight * (1.0 - m.w_t) * m.w_r;
+        let reflected = if m.branches.reflect && self.keep(w_reflect, skipped) {
             let dir = model::reflect(ray.dir, n).normalize();
-            self.trace(&spawn(dir, !front), depth + 1, counts)
+            self.trace(&spawn(dir, !front), depth + 1, w_reflect, counts, skipped)
         } else {
             Vec3::ZERO
         };
-        let transmitted = if m.branches.transmit {
+        let w_transmit = weight * m.w_t;
+        let transmitted = if m.branches.transmit && self.keep(w_transmit, skipped) {
             let (dir, crosses) = model::transmit(ray.dir, n, front, m.ior);
-            self.trace(&spawn(dir, front == crosses), depth + 1, counts)
+            self.trace(
+                &spawn(dir, front == crosses),
+                depth + 1,
+                w_transmit,
+                counts,
+                skipped,
+            )
         } else {
             Vec3::ZERO
         };
@@ -125,21 +182,28 @@ impl FastTracer {
     }
 }
 
+/// The largest colour component any trace can return: sky colours and, for local
+/// shading, the sum over lights of the brightest component (kd ≤ 1, cos ≤ 1, s ≤ 1).
+fn value_bound(scene: &Scene) -> f32 {
+    let sky = scene.sky.down.max_element().max(scene.sky.up.max_element());
+    let lights: f64 = scene.lights.iter().map(|l| l.intensity.max_element()).sum();
+    sky.max(lights) as f32
+}
+
 impl SampleTracer for FastTracer {
     fn sample(&self, s: f32, t: f32, counts: &mut RayCounts) -> Vec3 {
-        let dir = model::primary_direction(
-            self.origin,
-            self.lower_left,
-            self.horizontal,
-            self.vertical,
-            s,
-            t,
-        );
+        self.sample_bounded(s, t, counts).0
+    }
+
+    fn sample_bounded(&self, s: f32, t: f32, counts: &mut RayCounts) -> (Vec3, f32) {
+        let dir = model::primary_direction(self.corner, self.horizontal, self.vertical, s, t);
         let ray = Query {
             origin: self.origin,
             dir,
             from: None,
         };
-        self.trace(&ray, 0, counts)
+        let mut skipped = Skipped::default();
+        let colour = self.trace(&ray, 0, 1.0, counts, &mut skipped);
+        (colour, skipped.weight * self.value_bound)
     }
 }

@@ -32,4 +32,10 @@ impl RayCounts {
 pub trait SampleTracer: Sync {
     /// The colour of the ray through film position `(s, t)` ∈ [0,1]² (`t` from the bottom).
     fn sample(&self, s: f32, t: f32, counts: &mut RayCounts) -> Vec3;
+
+    /// The sample and a bound of its error from skipped work (quality settings such as
+    /// the contribution cutoff): `|exact − returned| ≤ bound` in every component.
+    fn sample_bounded(&self, s: f32, t: f32, counts: &mut RayCounts) -> (Vec3, f32) {
+        (self.sample(s, t, counts), 0.0)
+    }
 }

@@ -166,7 +166,7 @@ impl<'a> ReferenceTracer<'a> {
     /// The linear colour of the ray through film position `(s, t)`, in `f64`.
     pub fn sample_f64(&self, s: f64, t: f64, counts: &mut RayCounts) -> DVec3 {
         let c = &self.camera;
-        let dir = model::primary_direction(c.origin, c.lower_left, c.horizontal, c.vertical, s, t);
+        let dir = model::primary_direction(c.lower_left - c.origin, c.horizontal, c.vertical, s, t);
         let ray = Ray {
             origin: c.origin,
             dir,

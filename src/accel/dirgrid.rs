@@ -1,0 +1,287 @@
+//! A directional grid around one point: a cube map whose cells list the spheres seen
+//! in that cell's directions, nearest first. Rays through the point — primary rays
+//! from the camera, shadow rays to a point light — test only their cell's spheres:
+//! the "light buffer" of Haines and Greenberg (1986), used for the eye as well.
+//!
+//! Cells are filled conservatively (a sphere's bounding box, widened), so a query
+//! sees every sphere it could hit: the grid changes the work, never the answer.
+
+use glam::{DVec3, Vec3};
+
+pub struct DirGrid {
+    /// The point every ray of the grid passes through.
+    pub centre: DVec3,
+    /// Cells per face side.
+    n: u32,
+    /// Cell `c` lists `items[offsets[c]..offsets[c+1]]`.
+    offsets: Vec<u32>,
+    items: Vec<u32>,
+    /// Per item entry: the sphere's nearest distance from the centre, rounded down.
+    near: Vec<f32>,
+    /// Spheres that contain the centre: seen in every direction.
+    pub always: Vec<u32>,
+}
+
+/// Widening of each sphere's range in face coordinates (cells are `2/n` wide): covers
+/// the rounding of query directions many times over.
+const WIDEN: f64 = 1e-4;
+
+impl DirGrid {
+    /// Builds the grid around `centre` for spheres `(centre, radius)`.
+    pub fn build(centre: DVec3, spheres: &[(DVec3, f64)], n: u32) -> DirGrid {
+        let faces = 6 * (n as usize) * (n as usize);
+        // Each sphere's nearest distance from the centre, rounded down so that the
+        // early exit of queries stays conservative.
+        let near_of: Vec<f32> = spheres
+            .iter()
+            .map(|&(c, r)| {
+                let dist = (c - centre).length();
+                let d = (dist - r) - 1e-6 * (dist + r + centre.abs().max_element());
+                let f = d as f32;
+                if f64::from(f) > d {
+                    f.next_down()
+                } else {
+                    f
+                }
+            })
+            .collect();
+        // Visit spheres nearest first: the stable fill below then leaves every cell's
+        // list sorted, so closest-hit queries can stop early.
+        let mut order: Vec<u32> = (0..spheres.len() as u32).collect();
+        order.sort_unstable_by(|&a, &b| near_of[a as usize].total_cmp(&near_of[b as usize]));
+
+        let cones = CellCones::shared(n);
+        let mut always = Vec::new();
+        let mut pairs: Vec<(u32, u32)> = Vec::new(); // (cell, sphere)
+        for &k in &order {
+            let (c, r) = spheres[k as usize];
+            let rel = c - centre;
+            let reach = r * (1.0 + 1e-6) + 1e-9 * rel.abs().max_element();
+            let dist = rel.length();
+            if dist <= reach {
+                always.push(k);
+                continue;
+            }
+            let sphere_cone = SphereCone::new(rel, dist, r);
+            let (lo, hi) = (rel - DVec3::splat(reach), rel + DVec3::splat(reach));
+            for face in 0..6u32 {
+                let Some([u0, u1, v0, v1]) = face_rect(face, lo, hi, n) else {
+                    continue;
+                };
+                for v in v0..=v1 {
+                    for u in u0..=u1 {
+                        if cones.meets(face, u, v, &sphere_cone) {
+                            pairs.push((cell_index(face, u, v, n) as u32, k));
+                        }
+                    }
+                }
+            }
+        }
+        // Counting sort by cell (stable: keeps the nearest-first order).
+        let mut offsets = vec![0u32; faces + 1];
+        for &(cell, _) in &pairs {
+            offsets[cell as usize + 1] += 1;
+        }
+        for c in 0..faces {
+            offsets[c + 1] += offsets[c];
+        }
+        let mut fill = offsets.clone();
+        let mut items = vec![0u32; pairs.len()];
+        for &(cell, k) in &pairs {
+            items[fill[cell as usize] as usize] = k;
+            fill[cell as usize] += 1;
+        }
+        let near = items.iter().map(|&k| near_of[k as usize]).collect();
+        DirGrid {
+            centre,
+            n,
+            offsets,
+            items,
+            near,
+            always,
+        }
+    }
+
+    pub fn debug_stats(&self) {
+        let cells = self.offsets.len() - 1;
+        let nonempty = (0..cells)
+            .filter(|&c| self.offsets[c + 1] > self.offsets[c])
+            .count();
+        let max = (0..cells)
+            .map(|c| self.offsets[c + 1] - self.offsets[c])
+            .max()
+            .unwrap_or(0);
+        eprintln!(
+            "cells {cells} nonempty {nonempty} items {} max {max} always {}",
+            self.items.len(),
+            self.always.len()
+        );
+    }
+
+    /// The cell of direction `d` (any length, not zero).
+    #[inline]
+    pub fn cell(&self, d: Vec3) -> usize {
+        let a = d.abs();
+        let (face, major, u, v) = if a.x >= a.y && a.x >= a.z {
+            (u32::from(d.x < 0.0), a.x, d.y, d.z)
+        } else if a.y >= a.z {
+            (2 + u32::from(d.y < 0.0), a.y, d.x, d.z)
+        } else {
+            (4 + u32::from(d.z < 0.0), a.z, d.x, d.y)
+        };
+        let n = self.n as f32;
+        let to_cell = |x: f32| (((x / major + 1.0) * 0.5 * n) as u32).min(self.n - 1);
+        cell_index(face, to_cell(u), to_cell(v), self.n)
+    }
+
+    /// The spheres of a cell, nearest first, with their nearest distances.
+    #[inline]
+    pub fn candidates(&self, cell: usize) -> (&[u32], &[f32]) {
+        let range = self.offsets[cell] as usize..self.offsets[cell + 1] as usize;
+        (&self.items[range.clone()], &self.near[range])
+    }
+}
+
+/// The cone of directions of each cell of a face (the same for all six faces in face
+/// coordinates): its axis and the cosine of its half-angle, widened.
+struct CellCones {
+    n: u32,
+    /// Per (u, v): unit axis in face coordinates (u, v, 1)/|…| and cos, sin of the half-angle.
+    cones: Vec<(DVec3, f64, f64)>,
+}
+
+impl CellCones {
+    /// The cones for `n` cells per side, computed once per process.
+    fn shared(n: u32) -> std::sync::Arc<CellCones> {
+        static CACHE: std::sync::Mutex<Vec<std::sync::Arc<CellCones>>> =
+            std::sync::Mutex::new(Vec::new());
+        let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(c) = cache.iter().find(|c| c.n == n) {
+            return c.clone();
+        }
+        let cones = std::sync::Arc::new(CellCones::new(n));
+        cache.push(cones.clone());
+        cones
+    }
+
+    fn new(n: u32) -> Self {
+        let mut cones = Vec::with_capacity((n * n) as usize);
+        let at = |i: u32| -1.0 + 2.0 * f64::from(i) / f64::from(n);
+        for v in 0..n {
+            for u in 0..n {
+                let corners = [
+                    DVec3::new(at(u), at(v), 1.0),
+                    DVec3::new(at(u + 1), at(v), 1.0),
+                    DVec3::new(at(u), at(v + 1), 1.0),
+                    DVec3::new(at(u + 1), at(v + 1), 1.0),
+                ];
+                let axis = (corners[0] + corners[3]).normalize();
+                let cos_min = corners
+                    .iter()
+                    .map(|c| c.normalize().dot(axis))
+                    .fold(1.0f64, f64::min);
+                // Widen by a fraction of the cell: query rounding lands near borders.
+                let half = cos_min.clamp(-1.0, 1.0).acos() * 1.05 + 1e-6;
+                cones.push((axis, half.cos(), half.sin()));
+            }
+        }
+        CellCones { n, cones }
+    }
+
+    /// Whether the cell's cone meets the sphere's cone.
+    #[inline]
+    fn meets(&self, face: u32, u: u32, v: u32, sphere: &SphereCone) -> bool {
+        let (axis, cos_cell, sin_cell) = self.cones[(v * self.n + u) as usize];
+        let axis = from_face(face, axis);
+        // The angle between the axes must not exceed the sum of the half-angles.
+        let cos_between = sphere.axis.dot(axis);
+        let cos_sum = cos_cell * sphere.cos - sin_cell * sphere.sin;
+        let sum_exceeds_pi = sin_cell * sphere.cos + cos_cell * sphere.sin < 0.0;
+        sum_exceeds_pi || cos_between >= cos_sum - 1e-9
+    }
+}
+
+/// The cone of directions in which a sphere is seen from the centre.
+struct SphereCone {
+    axis: DVec3,
+    cos: f64,
+    sin: f64,
+}
+
+impl SphereCone {
+    fn new(rel: DVec3, dist: f64, r: f64) -> Self {
+        let sin = (r / dist).min(1.0);
+        SphereCone {
+            axis: rel / dist,
+            cos: (1.0 - sin * sin).sqrt(),
+            sin,
+        }
+    }
+}
+
+/// A face-coordinate vector (u, v, w along the face's outward axis) in world axes.
+fn from_face(face: u32, f: DVec3) -> DVec3 {
+    let w = if face % 2 == 0 { f.z } else { -f.z };
+    match face / 2 {
+        0 => DVec3::new(w, f.x, f.y),
+        1 => DVec3::new(f.x, w, f.y),
+        _ => DVec3::new(f.x, f.y, w),
+    }
+}
+
+#[inline]
+fn cell_index(face: u32, u: u32, v: u32, n: u32) -> usize {
+    ((face * n + v) * n + u) as usize
+}
+
+/// The cells of `face` that the box `[lo, hi]` (relative to the centre) may be seen in,
+/// as `[u0, u1, v0, v1]`, or `None` when the box is not seen in that face.
+fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
+    let axis = (face / 2) as usize;
+    let (b, c) = match axis {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    // Coordinates with the face's axis pointing outwards.
+    let (a_lo, a_hi) = if face % 2 == 0 {
+        (lo[axis], hi[axis])
+    } else {
+        (-hi[axis], -lo[axis])
+    };
+    if a_hi <= 0.0 {
+        return None;
+    }
+    let range = |x_lo: f64, x_hi: f64| -> (f64, f64) {
+        if a_lo <= 0.0 {
+            // The box reaches the face plane: a → 0⁺ sends x/a to ±∞ unless x keeps
+            // one sign, in which case the largest a bounds it on one side.
+            let min = if x_lo >= 0.0 {
+                x_lo / a_hi
+            } else {
+                f64::NEG_INFINITY
+            };
+            let max = if x_hi <= 0.0 {
+                x_hi / a_hi
+            } else {
+                f64::INFINITY
+            };
+            return (min, max);
+        }
+        // x/a over the box: smallest with the largest a when x ≥ 0, and so on.
+        let min = x_lo / if x_lo >= 0.0 { a_hi } else { a_lo };
+        let max = x_hi / if x_hi >= 0.0 { a_lo } else { a_hi };
+        (min, max)
+    };
+    let (u_lo, u_hi) = range(lo[b], hi[b]);
+    let (v_lo, v_hi) = range(lo[c], hi[c]);
+    let (u_lo, u_hi, v_lo, v_hi) = (u_lo - WIDEN, u_hi + WIDEN, v_lo - WIDEN, v_hi + WIDEN);
+    if u_lo > 1.0 || u_hi < -1.0 || v_lo > 1.0 || v_hi < -1.0 {
+        return None;
+    }
+    let to_cell = |x: f64| {
+        let x = x.clamp(-1.0, 1.0);
+        (((x + 1.0) * 0.5 * f64::from(n)) as u32).min(n - 1)
+    };
+    Some([to_cell(u_lo), to_cell(u_hi), to_cell(v_lo), to_cell(v_hi)])
+}
