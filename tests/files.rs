@@ -277,3 +277,29 @@ fn bytes_are_rounded_and_clamped_linear_values() {
     assert_eq!(image_io::to_byte(f32::INFINITY), 255);
     assert_eq!(image_io::to_byte(f32::NAN), 0);
 }
+
+#[test]
+fn the_committed_readme_image_is_the_hw3_render() {
+    // assets/hw3.png (shown in README.md) is `whitted render -o assets/hw3.png`. Speed
+    // work may move a pixel by a level on an edge; anything more means it is stale.
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/hw3.png");
+    let committed = image::open(path).expect("assets/hw3.png").into_rgb8();
+    let scene = hw3_scene(HW3_DEFAULT_SEED);
+    let opts = RenderOptions::for_scene(&scene);
+    let (frame, _) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+    let fresh = image_io::to_rgb8(&frame);
+    assert_eq!(committed.dimensions(), (1280, 720));
+    let off: Vec<u8> = committed
+        .pixels()
+        .zip(fresh.pixels())
+        .map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap())
+        .filter(|&d| d > 0)
+        .collect();
+    assert!(
+        off.len() <= 100 && off.iter().all(|&d| d <= 1),
+        "assets/hw3.png is stale ({} pixels differ, by up to {:?} levels): regenerate it \
+         with `whitted render -o assets/hw3.png`",
+        off.len(),
+        off.iter().max()
+    );
+}
