@@ -147,10 +147,7 @@ fn main() -> ExitCode {
             runs,
             threads,
         }) => time_command(scene.as_deref(), runs, threads),
-        Some(Command::Scene { name: _, seed }) => {
-            print!("{}", scene::hw3_toml(seed));
-            Ok(())
-        }
+        Some(Command::Scene { name: _, seed }) => scene_command(seed),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -180,6 +177,17 @@ fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
 fn view(path: Option<&Path>) -> anyhow::Result<()> {
     let scene = load_scene(path)?;
     whitted::viewer::run(scene)
+}
+
+fn scene_command(seed: u64) -> anyhow::Result<()> {
+    use std::io::Write;
+    let text = scene::hw3_toml(seed);
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        // A reader that stops early (`| head`) is not an error.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        result => result.context("cannot write the scene to standard output"),
+    }
 }
 
 fn time_command(path: Option<&Path>, runs: usize, threads: Option<u32>) -> anyhow::Result<()> {

@@ -272,3 +272,18 @@ fn a_good_render_exits_0_with_a_closing_line() {
     assert_eq!(out.status.code(), Some(0));
     assert!(out.stderr.is_empty(), "{}", stderr(&out));
 }
+
+#[test]
+fn scene_printing_fails_cleanly_when_stdout_cannot_be_written() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        eprintln!("SKIPPED: scene_printing_fails_cleanly: no /dev/full on this system");
+        return;
+    };
+    let out = Command::new(env!("CARGO_BIN_EXE_whitted"))
+        .args(["scene", "hw3"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    // A clear error and status 1, not a panic (status 101).
+    assert_fails_with(&out, &["standard output"]);
+}
