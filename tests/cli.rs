@@ -299,10 +299,11 @@ fn an_interrupted_render_writes_nothing() {
         .spawn()
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(500));
-    let sent = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+    // The shell's built-in `kill` (a minimal system may have no kill program).
+    let sent = Command::new("sh")
+        .args(["-c", &format!("kill -INT {}", child.id())])
         .status()
-        .expect("run kill");
+        .expect("run sh");
     assert!(sent.success());
     let out = child.wait_with_output().unwrap();
     assert_fails_with(&out, &["interrupted"]);
