@@ -4,6 +4,7 @@
 //! sphere tests decide.
 
 use glam::Vec3;
+use wide::{f32x4, CmpLe};
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug)]
@@ -44,32 +45,57 @@ pub struct Node {
     pub axis: u32,
 }
 
+/// The tree as the queries use it: four children per node, their boxes side by side
+/// so that one SIMD test checks all four.
 pub struct Bvh {
-    pub nodes: Vec<Node>,
+    nodes: Vec<Node4>,
     /// Item indices in leaf order.
-    pub items: Vec<u32>,
+    items: Vec<u32>,
+}
+
+/// A node of the 4-wide tree: child boxes as four lanes per coordinate.
+#[derive(Clone, Copy, Debug)]
+struct Node4 {
+    min: [f32x4; 3],
+    max: [f32x4; 3],
+    /// Per child: the node index (inner) or the first item (leaf).
+    child: [u32; 4],
+    /// Per child: 0 for an inner node, else the number of items of the leaf.
+    count: [u32; 4],
+    /// Lanes that hold a child.
+    used: u32,
 }
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
 /// Depth after which splits are by count: keeps any tree below `STACK` levels.
 const MAX_SAH_DEPTH: u32 = 48;
-const STACK: usize = 96;
+const STACK: usize = 256;
 
 impl Bvh {
-    /// Builds over `boxes` (one per item).
+    /// Builds over `boxes` (one per item): a binary binned-SAH tree, then collapsed.
     pub fn build(boxes: &[Aabb]) -> Bvh {
         let mut items: Vec<u32> = (0..boxes.len() as u32).collect();
         let centres: Vec<Vec3> = boxes.iter().map(Aabb::centre).collect();
-        let mut nodes = Vec::with_capacity(2 * boxes.len().max(1));
+        let mut binary = Vec::with_capacity(2 * boxes.len().max(1));
         if !boxes.is_empty() {
-            build_node(boxes, &centres, &mut items, 0, 0, &mut nodes);
+            build_node(boxes, &centres, &mut items, 0, 0, &mut binary);
+        }
+        let mut nodes = Vec::with_capacity(binary.len() / 2 + 1);
+        if let Some(root) = binary.first() {
+            if root.count > 0 {
+                // A single leaf: wrap it in a node of one child.
+                nodes.push(node4(&binary, &[0]));
+            } else {
+                collapse(&binary, 0, &mut nodes);
+            }
         }
         Bvh { nodes, items }
     }
 
     /// Calls `visit(item)` for every item whose box the ray `o + t·d` (`inv_d = 1/d`)
-    /// meets within `[0, t_max]`; `visit` returns a lower `t_max` when it finds a hit.
+    /// meets within `[0, t_max]`, roughly nearest first; `visit` returns a lower `t_max`
+    /// when it finds a hit.
     #[inline]
     pub fn traverse(
         &self,
@@ -81,51 +107,126 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
-        let negative = [inv_d.x < 0.0, inv_d.y < 0.0, inv_d.z < 0.0];
-        let mut stack = [0u32; STACK];
-        let mut top = 0usize;
-        let mut node = 0u32;
-        loop {
+        // Finite reciprocals: a zero direction component would give 0·∞ = NaN.
+        let finite = |x: f32| {
+            if x.is_finite() {
+                x
+            } else {
+                f32::MAX.copysign(x)
+            }
+        };
+        let inv = [finite(inv_d.x), finite(inv_d.y), finite(inv_d.z)];
+        let o4 = [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)];
+        let inv4 = inv.map(f32x4::splat);
+        let mut stack = [(0u32, 0.0f32); STACK];
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let (node, t_enter) = stack[top];
+            if t_enter > t_max {
+                continue;
+            }
             let n = &self.nodes[node as usize];
-            if slab(&n.bounds, o, inv_d, t_max) {
-                if n.count > 0 {
-                    for &item in &self.items[n.index as usize..(n.index + n.count) as usize] {
+            let mut near = f32x4::splat(0.0);
+            let mut far = f32x4::splat(t_max);
+            for a in 0..3 {
+                let t0 = (n.min[a] - o4[a]) * inv4[a];
+                let t1 = (n.max[a] - o4[a]) * inv4[a];
+                near = near.max(t0.min(t1));
+                far = far.min(t0.max(t1));
+            }
+            let hit = (near.cmp_le(far).move_mask() as u32) & n.used;
+            if hit == 0 {
+                continue;
+            }
+            let near = near.to_array();
+            // Leaves now, nearest first; inner children onto the stack, farthest first.
+            let mut order = [0usize; 4];
+            let mut k = 0;
+            for lane in 0..4 {
+                if hit & (1 << lane) != 0 {
+                    order[k] = lane;
+                    k += 1;
+                }
+            }
+            let order = &mut order[..k];
+            order.sort_unstable_by(|&a, &b| near[a].total_cmp(&near[b]));
+            for &lane in order.iter() {
+                if n.count[lane] > 0 && near[lane] <= t_max {
+                    let first = n.child[lane] as usize;
+                    for &item in &self.items[first..first + n.count[lane] as usize] {
                         if let Some(t) = visit(item) {
                             t_max = t_max.min(t);
                         }
                     }
-                } else {
-                    // Near child first: the left child holds the smaller coordinates.
-                    let (near, far) = if negative[n.axis as usize] {
-                        (n.index, node + 1)
-                    } else {
-                        (node + 1, n.index)
-                    };
-                    stack[top] = far;
-                    top += 1;
-                    node = near;
-                    continue;
                 }
             }
-            if top == 0 {
-                return;
+            for &lane in order.iter().rev() {
+                if n.count[lane] == 0 {
+                    stack[top] = (n.child[lane], near[lane]);
+                    top += 1;
+                }
             }
-            top -= 1;
-            node = stack[top];
         }
     }
 }
 
-/// Whether the ray meets the box at some `t` in `[0, t_max]`.
-#[inline(always)]
-fn slab(b: &Aabb, o: Vec3, inv_d: Vec3, t_max: f32) -> bool {
-    let t0 = (b.min - o) * inv_d;
-    let t1 = (b.max - o) * inv_d;
-    // min/max ignore NaN (0·∞ on a ray in a box face plane), keeping the test
-    // conservative.
-    let near = t0.min(t1).max_element().max(0.0);
-    let far = t0.max(t1).min_element().min(t_max);
-    near <= far
+/// Collapses the binary subtree at inner node `b` into 4-wide nodes; returns its index.
+fn collapse(binary: &[Node], b: usize, out: &mut Vec<Node4>) -> u32 {
+    // Open the largest inner child until there are four children.
+    let mut children = vec![b + 1, binary[b].index as usize];
+    while children.len() < 4 {
+        let open = children
+            .iter()
+            .enumerate()
+            .filter(|(_, &c)| binary[c].count == 0)
+            .max_by(|a, b| {
+                binary[*a.1]
+                    .bounds
+                    .half_area()
+                    .total_cmp(&binary[*b.1].bounds.half_area())
+            })
+            .map(|(i, _)| i);
+        let Some(i) = open else { break };
+        let c = children.swap_remove(i);
+        children.push(c + 1);
+        children.push(binary[c].index as usize);
+    }
+    let me = out.len() as u32;
+    out.push(node4(binary, &children));
+    for (lane, &c) in children.iter().enumerate() {
+        if binary[c].count == 0 {
+            let index = collapse(binary, c, out);
+            out[me as usize].child[lane] = index;
+        }
+    }
+    me
+}
+
+/// A 4-wide node over the binary nodes `children` (inner children get their index later).
+fn node4(binary: &[Node], children: &[usize]) -> Node4 {
+    let mut min = [[f32::INFINITY; 4]; 3];
+    let mut max = [[f32::NEG_INFINITY; 4]; 3];
+    let mut child = [0u32; 4];
+    let mut count = [0u32; 4];
+    let mut used = 0u32;
+    for (lane, &c) in children.iter().enumerate() {
+        let n = &binary[c];
+        for a in 0..3 {
+            min[a][lane] = n.bounds.min[a];
+            max[a][lane] = n.bounds.max[a];
+        }
+        child[lane] = n.index;
+        count[lane] = n.count;
+        used |= 1 << lane;
+    }
+    Node4 {
+        min: min.map(f32x4::from),
+        max: max.map(f32x4::from),
+        child,
+        count,
+        used,
+    }
 }
 
 fn build_node(
@@ -218,11 +319,14 @@ fn best_split(
     bounds: &Aabb,
 ) -> Option<(usize, f32)> {
     let mut best: Option<(f32, usize, f32)> = None;
-    for axis in 0..3 {
+    // Bin along the axis where the centres spread most (a third of the work of trying
+    // all three, for trees nearly as good).
+    let axis = (centre_bounds.max - centre_bounds.min).max_position();
+    {
         let lo = centre_bounds.min[axis];
         let hi = centre_bounds.max[axis];
         if hi <= lo {
-            continue;
+            return None;
         }
         let scale = BINS as f32 / (hi - lo);
         let mut bin_bounds = [Aabb::EMPTY; BINS];

@@ -15,9 +15,8 @@ pub struct DirGrid {
     n: u32,
     /// Cell `c` lists `items[offsets[c]..offsets[c+1]]`.
     offsets: Vec<u32>,
-    items: Vec<u32>,
-    /// Per item entry: the sphere's nearest distance from the centre, rounded down.
-    near: Vec<f32>,
+    /// Per entry: the sphere, and its nearest distance from the centre rounded down.
+    items: Vec<(u32, f32)>,
     /// Spheres that contain the centre: seen in every direction.
     pub always: Vec<u32>,
 }
@@ -91,13 +90,15 @@ impl DirGrid {
             items[fill[cell as usize] as usize] = k;
             fill[cell as usize] += 1;
         }
-        let near = items.iter().map(|&k| near_of[k as usize]).collect();
+        let items = items
+            .into_iter()
+            .map(|k| (k, near_of[k as usize]))
+            .collect();
         DirGrid {
             centre,
             n,
             offsets,
             items,
-            near,
             always,
         }
     }
@@ -129,16 +130,18 @@ impl DirGrid {
         } else {
             (4 + u32::from(d.z < 0.0), a.z, d.x, d.y)
         };
-        let n = self.n as f32;
-        let to_cell = |x: f32| (((x / major + 1.0) * 0.5 * n) as u32).min(self.n - 1);
+        // (x/major + 1)·n/2 with one division.
+        let half_n = 0.5 * self.n as f32;
+        let scale = half_n / major;
+        let to_cell = |x: f32| ((x * scale + half_n) as u32).min(self.n - 1);
         cell_index(face, to_cell(u), to_cell(v), self.n)
     }
 
-    /// The spheres of a cell, nearest first, with their nearest distances.
+    /// The spheres of a cell with their nearest distances, nearest first.
     #[inline]
-    pub fn candidates(&self, cell: usize) -> (&[u32], &[f32]) {
-        let range = self.offsets[cell] as usize..self.offsets[cell + 1] as usize;
-        (&self.items[range.clone()], &self.near[range])
+    pub fn candidates(&self, cell: usize) -> &[(u32, f32)] {
+        let (start, end) = (self.offsets[cell] as usize, self.offsets[cell + 1] as usize);
+        &self.items[start..end]
     }
 }
 

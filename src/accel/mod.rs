@@ -53,9 +53,6 @@ impl Query {
 #[derive(Clone, Copy)]
 struct Ray {
     o64: DVec3,
-    /// The direction renormalised in `f64`: the exact tests assume `d·d = 1`, which an
-    /// `f32`-normalised direction misses by up to ~1e-7.
-    d64: DVec3,
     d32: Vec3,
     from: Option<(u32, Side)>,
     t_min: f64,
@@ -66,7 +63,6 @@ impl Ray {
     fn new(q: &Query) -> Ray {
         Ray {
             o64: q.origin,
-            d64: q.dir.as_dvec3().normalize(),
             d32: q.dir,
             from: q.from,
             t_min: q.t_min(),
@@ -211,7 +207,10 @@ impl Spheres {
     /// The first crossing of sphere `k` in `(t_min, t_max)`: `(t, entering, normal)`.
     #[inline]
     fn crossing(&self, k: usize, ray: &Ray, t_max: f64) -> Option<(f64, bool, DVec3)> {
-        let (o, d, t_min) = (ray.o64, ray.d64, ray.t_min);
+        // The direction renormalised in `f64`: the exact tests assume `d·d = 1`, which
+        // an `f32`-normalised direction misses by up to ~1e-7. Done here, for the few
+        // spheres that pass the quick test, not for every ray.
+        let (o, d, t_min) = (ray.o64, ray.d32.as_dvec3().normalize(), ray.t_min);
         let (c, r) = (self.center[k], self.radius[k]);
         let own = ray
             .from
@@ -285,8 +284,7 @@ impl Spheres {
         for &k in &grid.always {
             self.consider(k, &ray, &mut best);
         }
-        let (items, near) = grid.candidates(grid.cell(q.dir));
-        for (&k, &near) in items.iter().zip(near) {
+        for &(k, near) in grid.candidates(grid.cell(q.dir)) {
             if f64::from(near) >= best.t {
                 break; // the rest are all farther
             }
@@ -330,8 +328,7 @@ impl Spheres {
         for &k in &grid.always {
             self.occlude(k, &ray, dist, &mut factor);
         }
-        let (items, near) = grid.candidates(grid.cell((q.origin - grid.centre).as_vec3()));
-        for (&k, &near) in items.iter().zip(near) {
+        for &(k, near) in grid.candidates(grid.cell((q.origin - grid.centre).as_vec3())) {
             if f64::from(near) >= dist || factor <= 0.0 {
                 break; // beyond the hit point, seen from the light
             }

@@ -24,10 +24,10 @@ const PALETTE: [[f64; 3]; 8] = [
 ];
 
 /// Python's `random.Random(seed)` for the calls the generator makes.
-struct PyRandom(Mt);
+pub(super) struct PyRandom(Mt);
 
 impl PyRandom {
-    fn new(seed: u64) -> Self {
+    pub(super) fn new(seed: u64) -> Self {
         // Python seeds with the 32-bit words of the integer, least significant first.
         let key: Vec<u32> = if seed >> 32 == 0 {
             vec![seed as u32]
@@ -38,7 +38,7 @@ impl PyRandom {
     }
 
     /// `random()`: 53 random bits in [0, 1).
-    fn random(&mut self) -> f64 {
+    pub(super) fn random(&mut self) -> f64 {
         let a = f64::from(self.0.next_u32() >> 5);
         let b = f64::from(self.0.next_u32() >> 6);
         (a * 67_108_864.0 + b) * (1.0 / 9_007_199_254_740_992.0)
@@ -54,6 +54,20 @@ impl PyRandom {
             }
         }
     }
+}
+
+/// A small ball's colour and weights `(kd, w_r, w_t)`: a palette colour, then one of
+/// three kinds with equal chance: mirror-ish, glassy or plain diffuse.
+pub(super) fn random_material(rng: &mut PyRandom) -> (DVec3, f64, f64) {
+    let color = DVec3::from_array(PALETTE[rng.randrange(8) as usize]);
+    let a = rng.random();
+    let b = rng.random();
+    let (reflect, transmit) = match rng.randrange(3) {
+        0 => (a, 0.0), // mirror-ish
+        1 => (0.0, b), // glassy
+        _ => (0.0, 0.0),
+    };
+    (color, reflect, transmit)
 }
 
 /// The assignment's scene with the small balls drawn from `seed`.
@@ -81,14 +95,7 @@ pub fn hw3_scene(seed: u64) -> Scene {
     for _ in 0..48 {
         let x = rng.random() * 3.0 - 1.5;
         let z = rng.random() * 3.0 - 1.5;
-        let color = DVec3::from_array(PALETTE[rng.randrange(8) as usize]);
-        let a = rng.random();
-        let b = rng.random();
-        let (reflect, transmit) = match rng.randrange(3) {
-            0 => (a, 0.0), // mirror-ish
-            1 => (0.0, b), // glassy
-            _ => (0.0, 0.0),
-        };
+        let (color, reflect, transmit) = random_material(&mut rng);
         spheres.push(Sphere {
             color,
             reflect,

@@ -1,10 +1,20 @@
 //! Scene files (TOML, SPEC §4): parsing with `serde` + `toml`, then validation of every
 //! value with the line and column of the offending key. Nothing here panics on input.
+//!
+//! Memory: `toml` builds a tree of the whole document before `serde` sees it, about 35
+//! to 65 times the size of the text (measured: 483 MB for the 13.5 MB many_100000
+//! scene, 2.3 GB for a million minimal spheres). So the common layout of big scenes,
+//! the settings first and then a run of `[[sphere]]` tables to the end of the file, is
+//! parsed in batches of tables, in parallel ([`SphereRun`]; many_100000: 24 MB peak,
+//! 0.46 s instead of 0.9 s), and every other layout only up to
+//! [`limits::MAX_WHOLE_PARSE_BYTES`]. The sphere count is known from a scan of the
+//! lines before anything is parsed, so a file with too many spheres is refused first.
 
 use std::ops::Range;
 use std::path::Path;
 
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::Deserialize;
 use toml::Spanned;
 
@@ -18,10 +28,70 @@ type Int = Spanned<i64>;
 #[serde(deny_unknown_fields)]
 struct FileScene {
     camera: Option<Spanned<FileCamera>>,
-    image: Option<FileImage>,
+    image: Option<Spanned<FileImage>>,
     sky: Option<FileSky>,
-    light: Option<Vec<FileLight>>,
-    sphere: Option<Vec<FileSphere>>,
+    light: Option<Bounded<FileLight, LightLimit>>,
+    sphere: Option<Bounded<FileSphere, SphereLimit>>,
+}
+
+/// A batch of `[[sphere]]` tables of a run (see [`SphereRun`]) parsed on its own.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileSphereTable {
+    sphere: Vec<FileSphere>,
+}
+
+/// A cap on the length of an array in the file.
+trait Limit {
+    const MAX: usize;
+    const WHAT: &'static str;
+}
+
+struct SphereLimit;
+impl Limit for SphereLimit {
+    const MAX: usize = limits::MAX_SPHERES;
+    const WHAT: &'static str = "spheres";
+}
+
+struct LightLimit;
+impl Limit for LightLimit {
+    const MAX: usize = limits::MAX_LIGHTS;
+    const WHAT: &'static str = "lights";
+}
+
+/// An array that refuses its element number `L::MAX + 1` as soon as it is seen, rather
+/// than after all of them have been collected.
+struct Bounded<T, L>(Vec<T>, std::marker::PhantomData<L>);
+
+impl<'de, T: Deserialize<'de>, L: Limit> Deserialize<'de> for Bounded<T, L> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit<T, L>(std::marker::PhantomData<(T, L)>);
+        impl<'de, T: Deserialize<'de>, L: Limit> serde::de::Visitor<'de> for Visit<T, L> {
+            type Value = Bounded<T, L>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(f, "an array of at most {} {}", L::MAX, L::WHAT)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<Self::Value, A::Error> {
+                let mut items = Vec::new();
+                while let Some(item) = seq.next_element()? {
+                    if items.len() == L::MAX {
+                        return Err(serde::de::Error::custom(format!(
+                            "more than {} {}: the limit is {}",
+                            L::MAX,
+                            L::WHAT,
+                            L::MAX
+                        )));
+                    }
+                    items.push(item);
+                }
+                Ok(Bounded(items, std::marker::PhantomData))
+            }
+        }
+        d.deserialize_seq(Visit(std::marker::PhantomData))
+    }
 }
 
 #[derive(Deserialize)]
@@ -108,11 +178,13 @@ pub(super) fn load(path: &Path) -> Result<Scene, SceneError> {
 struct Locator<'a> {
     text: &'a str,
     path: &'a str,
+    /// Where the text that was parsed (and that spans count in) starts in `text`.
+    offset: usize,
 }
 
 impl Locator<'_> {
     fn at(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
-        let offset = span.start.min(self.text.len());
+        let offset = span.start.saturating_add(self.offset).min(self.text.len());
         let before = &self.text[..self.text.floor_char_boundary_compat(offset)];
         let line = before.matches('\n').count() + 1;
         let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
@@ -143,23 +215,217 @@ impl FloorCharBoundary for str {
     }
 }
 
+/// Parses and validates scene text, streaming a trailing run of `[[sphere]]` tables.
 pub(super) fn parse(text: &str, path: &str) -> Result<Scene, SceneError> {
-    let at = Locator { text, path };
-    let file: FileScene = toml::from_str(text).map_err(|e| {
+    let at = Locator {
+        text,
+        path,
+        offset: 0,
+    };
+    if text.len() as u64 > limits::MAX_FILE_BYTES {
+        return Err(at.whole(format!(
+            "scene text is {} bytes, more than the limit of {}",
+            text.len(),
+            limits::MAX_FILE_BYTES
+        )));
+    }
+    match SphereRun::find(text).map_err(|(offset, m)| at.at(offset..offset, m))? {
+        Some(run) => parse_with_run(text, path, &run),
+        None => parse_whole(text, path),
+    }
+}
+
+/// Parses and validates scene text as one TOML document (no streaming).
+pub(super) fn parse_whole(text: &str, path: &str) -> Result<Scene, SceneError> {
+    let at = Locator {
+        text,
+        path,
+        offset: 0,
+    };
+    if text.len() as u64 > limits::MAX_WHOLE_PARSE_BYTES {
+        return Err(at.whole(format!(
+            "scene text is {} bytes: files over {} bytes must put their spheres last, as \
+             [[sphere]] tables with no other table after them",
+            text.len(),
+            limits::MAX_WHOLE_PARSE_BYTES
+        )));
+    }
+    let file: FileScene = from_toml(text, &at)?;
+    let mut scene = settings(&at, &file)?;
+    let list = file.sphere.map(|b| b.0).unwrap_or_default();
+    scene.spheres.reserve_exact(list.len());
+    for (k, s) in list.iter().enumerate() {
+        scene.spheres.push(sphere(&at, s, k)?);
+    }
+    Ok(scene)
+}
+
+fn from_toml<T: serde::de::DeserializeOwned>(text: &str, at: &Locator) -> Result<T, SceneError> {
+    toml::from_str(text).map_err(|e| {
         let message = e.message().trim().replace('\n', " ");
         match e.span() {
             Some(span) => at.at(span, message),
             None => at.whole(message),
         }
-    })?;
+    })
+}
 
+/// Where a file's trailing run of `[[sphere]]` tables starts, and how many there are.
+struct SphereRun {
+    /// Byte offsets of the `[[sphere]]` header lines.
+    first: usize,
+    count: usize,
+}
+
+impl SphereRun {
+    /// Scans the lines (no allocation). `Err` when there are more `[[sphere]]` headers
+    /// than [`limits::MAX_SPHERES`]; `None` when the spheres are not one trailing run of
+    /// plain `[[sphere]]` tables, or when multi-line strings could hide header lines:
+    /// then the file is parsed whole.
+    fn find(text: &str) -> Result<Option<SphereRun>, (usize, String)> {
+        let mut first = None;
+        let mut count = 0usize;
+        let mut other_table_after = false;
+        let mut offset = 0;
+        for line in text.split_inclusive('\n') {
+            let start = offset;
+            offset += line.len();
+            let trimmed = line.trim_start();
+            if !trimmed.starts_with('[') {
+                continue;
+            }
+            if is_sphere_header(trimmed) {
+                count += 1;
+                if count > limits::MAX_SPHERES {
+                    return Err((
+                        start,
+                        format!(
+                            "more than {} [[sphere]] tables: the limit is {}",
+                            limits::MAX_SPHERES,
+                            limits::MAX_SPHERES
+                        ),
+                    ));
+                }
+                first.get_or_insert(start);
+            } else if first.is_some() {
+                other_table_after = true;
+            }
+        }
+        let multi_line_strings = text.contains("\"\"\"") || text.contains("'''");
+        Ok(match first {
+            Some(first) if !other_table_after && !multi_line_strings => {
+                Some(SphereRun { first, count })
+            }
+            _ => None,
+        })
+    }
+
+    /// The byte ranges of the tables of the run, in order.
+    fn tables<'t>(&self, text: &'t str) -> impl Iterator<Item = Range<usize>> + 't {
+        let mut starts = text[self.first..]
+            .split_inclusive('\n')
+            .scan(self.first, |offset, line| {
+                let start = *offset;
+                *offset += line.len();
+                Some((start, line))
+            })
+            .filter(|(_, line)| is_sphere_header(line.trim_start()))
+            .map(|(start, _)| start)
+            .peekable();
+        std::iter::from_fn(move || {
+            let start = starts.next()?;
+            let end = starts.peek().copied().unwrap_or(text.len());
+            Some(start..end)
+        })
+    }
+}
+
+/// `[[sphere]]`, spaces allowed inside the brackets, then nothing or a comment.
+fn is_sphere_header(line: &str) -> bool {
+    let Some(rest) = line.strip_prefix("[[") else {
+        return false;
+    };
+    let Some(rest) = rest.trim_start_matches([' ', '\t']).strip_prefix("sphere") else {
+        return false;
+    };
+    let Some(rest) = rest.trim_start_matches([' ', '\t']).strip_prefix("]]") else {
+        return false;
+    };
+    let rest = rest.trim();
+    rest.is_empty() || rest.starts_with('#')
+}
+
+/// The settings before the run as one document, then each sphere table on its own.
+fn parse_with_run(text: &str, path: &str, run: &SphereRun) -> Result<Scene, SceneError> {
+    let at = Locator {
+        text,
+        path,
+        offset: 0,
+    };
+    let head = &text[..run.first];
+    let file: FileScene = from_toml(head, &at)?;
+    if file.sphere.is_some() {
+        return Err(at.at(
+            run.first..run.first,
+            "[[sphere]] tables cannot follow a `sphere` array defined above",
+        ));
+    }
+    let mut scene = settings(&at, &file)?;
+    // Batches of consecutive tables, parsed in parallel: each batch's `toml` tree is
+    // small, and the batches come back in order, so the first error is the first in
+    // the file.
+    let mut batches: Vec<(usize, Range<usize>)> = Vec::new();
+    for (k, range) in run.tables(text).enumerate() {
+        match batches.last_mut() {
+            Some((first, batch)) if k - *first < TABLES_PER_BATCH => batch.end = range.end,
+            _ => batches.push((k, range)),
+        }
+    }
+    let parsed: Vec<Result<Vec<Sphere>, SceneError>> = batches
+        .par_iter()
+        .map(|(first, range)| {
+            let batch_at = Locator {
+                text,
+                path,
+                offset: range.start,
+            };
+            let tables: FileSphereTable = from_toml(&text[range.clone()], &batch_at)?;
+            tables
+                .sphere
+                .iter()
+                .enumerate()
+                .map(|(i, s)| sphere(&batch_at, s, first + i))
+                .collect()
+        })
+        .collect();
+    scene.spheres.reserve_exact(run.count);
+    for batch in parsed {
+        scene.spheres.extend(batch?);
+    }
+    if scene.spheres.len() != run.count {
+        // Cannot happen: each batch holds exactly its header lines' tables.
+        return Err(at.whole(format!(
+            "found {} spheres for {} [[sphere]] headers",
+            scene.spheres.len(),
+            run.count
+        )));
+    }
+    Ok(scene)
+}
+
+/// `[[sphere]]` tables parsed as one `toml` document when streaming (about 2 MB of tree).
+const TABLES_PER_BATCH: usize = 512;
+
+/// Everything but the spheres, validated.
+fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
     let camera = match &file.camera {
         None => None,
-        Some(c) => Some(camera(&at, c)?),
+        Some(c) => Some(camera(at, c)?),
     };
 
     let mut image = ImageSettings::default();
-    if let Some(img) = &file.image {
+    if let Some(spanned) = &file.image {
+        let img = spanned.get_ref();
         let dims = [
             (
                 &img.width,
@@ -212,37 +478,31 @@ pub(super) fn parse(text: &str, path: &str) -> Result<Scene, SceneError> {
             }
             image.seed = n as u64;
         }
-        image.check().map_err(|m| at.whole(m))?;
+        image.check().map_err(|m| at.at(spanned.span(), m))?;
     }
 
     let mut sky = Sky::default();
     if let Some(s) = &file.sky {
         if let Some(v) = &s.down {
-            sky.down = colour(&at, v, "sky.down")?;
+            sky.down = colour(at, v, "sky.down")?;
         }
         if let Some(v) = &s.up {
-            sky.up = colour(&at, v, "sky.up")?;
+            sky.up = colour(at, v, "sky.up")?;
         }
     }
 
     let lights = match &file.light {
         None => vec![Light::default()],
         Some(list) => {
-            if list.len() > limits::MAX_LIGHTS {
-                return Err(at.whole(format!(
-                    "{} lights, more than the limit of {}",
-                    list.len(),
-                    limits::MAX_LIGHTS
-                )));
-            }
+            let list = &list.0;
             let mut out = Vec::with_capacity(list.len());
             for (k, l) in list.iter().enumerate() {
                 let mut light = Light::default();
                 if let Some(v) = &l.position {
-                    light.position = finite(&at, v, &format!("light {}: position", k + 1))?;
+                    light.position = finite(at, v, &format!("light {}: position", k + 1))?;
                 }
                 if let Some(v) = &l.intensity {
-                    light.intensity = finite(&at, v, &format!("light {}: intensity", k + 1))?;
+                    light.intensity = finite(at, v, &format!("light {}: intensity", k + 1))?;
                     if light.intensity.min_element() < 0.0 {
                         return Err(
                             at.at(v.span(), format!("light {}: intensity must be >= 0", k + 1))
@@ -255,55 +515,47 @@ pub(super) fn parse(text: &str, path: &str) -> Result<Scene, SceneError> {
         }
     };
 
-    let file_spheres = file.sphere.unwrap_or_default();
-    if file_spheres.len() > limits::MAX_SPHERES {
-        return Err(at.whole(format!(
-            "{} spheres, more than the limit of {}",
-            file_spheres.len(),
-            limits::MAX_SPHERES
-        )));
-    }
-    let mut spheres = Vec::with_capacity(file_spheres.len());
-    for (k, s) in file_spheres.iter().enumerate() {
-        let who = format!("sphere {}", k + 1);
-        let center = finite(&at, &s.center, &format!("{who}: center"))?;
-        let radius = number(&at, &s.radius, &format!("{who}: radius"))?;
-        if radius <= 0.0 {
-            return Err(at.at(
-                s.radius.span(),
-                format!("{who}: radius must be > 0, got {radius}"),
-            ));
-        }
-        let mut sphere = Sphere::new(center, radius);
-        if let Some(v) = &s.color {
-            sphere.color = colour(&at, v, &format!("{who}: color"))?;
-        }
-        if let Some(v) = &s.reflect {
-            sphere.reflect = weight(&at, v, &format!("{who}: reflect"))?;
-        }
-        if let Some(v) = &s.transmit {
-            sphere.transmit = weight(&at, v, &format!("{who}: transmit"))?;
-        }
-        if let Some(v) = &s.ior {
-            sphere.ior = number(&at, v, &format!("{who}: ior"))?;
-            if sphere.ior < 1.0 {
-                return Err(at.at(
-                    v.span(),
-                    format!("{who}: ior must be >= 1, got {}", sphere.ior),
-                ));
-            }
-        }
-        spheres.push(sphere);
-    }
-
     Ok(Scene {
         name: "scene".into(),
         camera,
         image,
         sky,
         lights,
-        spheres,
+        spheres: Vec::new(),
     })
+}
+
+/// Sphere number `k` (from 0), validated.
+fn sphere(at: &Locator, s: &FileSphere, k: usize) -> Result<Sphere, SceneError> {
+    let who = format!("sphere {}", k + 1);
+    let center = finite(at, &s.center, &format!("{who}: center"))?;
+    let radius = number(at, &s.radius, &format!("{who}: radius"))?;
+    if radius <= 0.0 {
+        return Err(at.at(
+            s.radius.span(),
+            format!("{who}: radius must be > 0, got {radius}"),
+        ));
+    }
+    let mut sphere = Sphere::new(center, radius);
+    if let Some(v) = &s.color {
+        sphere.color = colour(at, v, &format!("{who}: color"))?;
+    }
+    if let Some(v) = &s.reflect {
+        sphere.reflect = weight(at, v, &format!("{who}: reflect"))?;
+    }
+    if let Some(v) = &s.transmit {
+        sphere.transmit = weight(at, v, &format!("{who}: transmit"))?;
+    }
+    if let Some(v) = &s.ior {
+        sphere.ior = number(at, v, &format!("{who}: ior"))?;
+        if sphere.ior < 1.0 {
+            return Err(at.at(
+                v.span(),
+                format!("{who}: ior must be >= 1, got {}", sphere.ior),
+            ));
+        }
+    }
+    Ok(sphere)
 }
 
 fn number(at: &Locator, v: &Num, what: &str) -> Result<f64, SceneError> {

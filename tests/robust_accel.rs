@@ -1,0 +1,198 @@
+//! Issue 4 at scale: the fast path's culling (f32 boxes of the BVH, widened f32 sphere
+//! tests, the directional grids around the eye and the lights) must never lose a hit
+//! or an occluder of spheres from radius 1e-3 to 1e5 scattered up to 1e4 from the
+//! origin. Every answer is compared with a brute-force `f64` test of every sphere;
+//! cases that are ambiguous at `f64` precision (near-tangent rays, near-ties, crossings
+//! at the ends of a shadow segment) are left out and counted.
+
+mod robust_support;
+
+use std::cell::RefCell;
+
+use glam::DVec3;
+use proptest::prelude::*;
+use robust_support::cases::runner;
+use robust_support::*;
+use whitted::accel::{Query, Spheres};
+use whitted::model::Side;
+use whitted::scene::Sphere;
+
+/// Random spheres: radius 10^U(−3,3), centre 10^U(−1,4) from the origin.
+fn world() -> impl Strategy<Value = Vec<Sphere>> {
+    prop::collection::vec(
+        (
+            log_uniform(-3.0, 3.0),
+            log_uniform(-1.0, 4.0),
+            unit_vector(),
+        ),
+        1..300,
+    )
+    .prop_map(|v| {
+        v.into_iter()
+            .map(|(r, d, u)| Sphere::new(u * d, r))
+            .collect()
+    })
+}
+
+/// The nearest crossing beyond `t_min` of each sphere, brute force in `f64`, with a
+/// flag saying whether it is too close to call (tangent, or within `tol` of an end).
+fn crossings(
+    o: DVec3,
+    d: DVec3,
+    spheres: &[Sphere],
+    skip: Option<(usize, Side)>,
+    t_min: f64,
+) -> Vec<(usize, f64, DVec3, bool)> {
+    let mut out = Vec::new();
+    for (k, s) in spheres.iter().enumerate() {
+        let own = skip.filter(|&(j, _)| j == k).map(|(_, side)| side);
+        if own == Some(Side::Outward) {
+            continue;
+        }
+        let f = s.center - o;
+        let off = f.cross(d).length();
+        let tangent = (off - s.radius).abs() <= 1e-7 * s.radius.max(f.length());
+        let Some((near, far)) = roots64(o, d, s.center, s.radius) else {
+            if tangent {
+                out.push((k, f64::NAN, DVec3::ZERO, true));
+            }
+            continue;
+        };
+        let t = if own == Some(Side::Inward) {
+            far
+        } else if near > t_min {
+            near
+        } else {
+            far
+        };
+        let end = (t - t_min).abs() <= 1e-7 * t.abs().max(1e-300);
+        if t > t_min || end {
+            let n = (o + d * t - s.center) / s.radius;
+            out.push((k, t, n, tangent || end));
+        }
+    }
+    out
+}
+
+#[derive(Default, Debug)]
+struct Counts {
+    rays: u64,
+    hits: u64,
+    ambiguous: u64,
+    wrong: u64,
+    shadow_rays: u64,
+    shadowed: u64,
+    shadow_ambiguous: u64,
+    shadow_wrong: u64,
+}
+
+#[test]
+fn culling_never_loses_a_hit_or_an_occluder() {
+    let counts = RefCell::new(Counts::default());
+    let rays = prop::collection::vec((unit_vector(), 0.0f64..1.0, 0.0f64..1.3), 24);
+    runner(300)
+        .run(
+            &(
+                world(),
+                log_uniform(-1.0, 4.0),
+                unit_vector(),
+                unit_vector(),
+                rays,
+            ),
+            |(spheres, eye_dist, eye_dir, light_dir, rays)| {
+                let eye = eye_dir * eye_dist;
+                let light = light_dir * (eye_dist * 3.0);
+                let set = Spheres::new(&spheres).with_grids(eye, &[light]);
+                let mut c = counts.borrow_mut();
+                for &(u, pick, spread) in &rays {
+                    // Aimed within 1.3 radii of a random sphere's centre: hits, misses
+                    // and silhouettes alike.
+                    let s =
+                        &spheres[((pick * spheres.len() as f64) as usize).min(spheres.len() - 1)];
+                    let dir = (s.center + u * (s.radius * spread) - eye).normalize_or(u);
+                    let q = Query {
+                        origin: eye,
+                        dir: dir.as_vec3().normalize(),
+                        from: None,
+                    };
+                    let (o, d) = query_ray(&q);
+                    let all = crossings(o, d, &spheres, None, 0.0);
+                    let mut sorted: Vec<_> = all.iter().filter(|x| !x.1.is_nan()).collect();
+                    sorted.sort_by(|a, b| a.1.total_cmp(&b.1));
+                    c.rays += 1;
+                    // Ambiguous: any doubtful crossing, or the two nearest nearly tied.
+                    let tie = sorted.len() >= 2
+                        && (sorted[1].1 - sorted[0].1) <= 1e-9 * sorted[1].1.abs();
+                    if all.iter().any(|x| x.3) || tie {
+                        c.ambiguous += 1;
+                        continue;
+                    }
+                    let want = sorted.first().map(|x| x.0 as u32);
+                    for (name, got) in [
+                        ("closest", set.closest(&q)),
+                        ("closest_primary", set.closest_primary(&q)),
+                    ] {
+                        let got_k = got.map(|h| h.sphere);
+                        if got_k != want {
+                            c.wrong += 1;
+                            prop_assert!(false, "{name}: sphere {got_k:?}, f64 says {want:?}");
+                        }
+                    }
+                    // A shadow ray from the hit towards the light, through grid and BVH.
+                    let Some(hit) = set.closest(&q) else { continue };
+                    c.hits += 1;
+                    let to = light - hit.point;
+                    let dist = to.length();
+                    let sq = Query {
+                        origin: hit.point,
+                        dir: (to / dist).as_vec3().normalize(),
+                        from: Some((hit.sphere, Side::Outward)),
+                    };
+                    let (so, sd) = query_ray(&sq);
+                    let occluders: Vec<_> = crossings(
+                        so,
+                        sd,
+                        &spheres,
+                        Some((hit.sphere as usize, Side::Outward)),
+                        sq.t_min(),
+                    )
+                    .into_iter()
+                    .filter(|x| x.1.is_nan() || x.1 < dist * (1.0 + 1e-7))
+                    .collect();
+                    c.shadow_rays += 1;
+                    let doubtful = occluders
+                        .iter()
+                        .any(|x| x.3 || (x.1 - dist).abs() <= 1e-7 * dist);
+                    if doubtful {
+                        c.shadow_ambiguous += 1;
+                        continue;
+                    }
+                    let want = occluders
+                        .iter()
+                        .map(|x| (1.0 + sd.dot(x.2)) * 0.5)
+                        .fold(1.0f64, f64::min);
+                    c.shadowed += u64::from(want < 1.0);
+                    for (name, got) in [
+                        ("shadow", set.shadow(&sq, dist)),
+                        ("shadow_to_light", set.shadow_to_light(&sq, dist, 0)),
+                    ] {
+                        if (f64::from(got) - want).abs() > 1e-5 {
+                            c.shadow_wrong += 1;
+                            prop_assert!(false, "{name}: factor {got}, f64 says {want}");
+                        }
+                    }
+                }
+                Ok(())
+            },
+        )
+        .unwrap_or_else(|e| panic!("{e}\n{:?}", counts.borrow()));
+    let c = counts.into_inner();
+    println!(
+        "culling: {} primary rays ({} ambiguous, left out; {} hits), {} wrong; {} shadow rays ({} ambiguous, {} shadowed), {} wrong",
+        c.rays, c.ambiguous, c.hits, c.wrong, c.shadow_rays, c.shadow_ambiguous, c.shadowed, c.shadow_wrong
+    );
+    assert!(
+        c.rays - c.ambiguous > 5000 && c.shadow_rays - c.shadow_ambiguous > 1000,
+        "{c:?}"
+    );
+}

@@ -1,0 +1,588 @@
+//! Issue 4, bad input that never hurts: a proptest fuzzer on the scene loader (arbitrary
+//! text, TOML-like token soup, and the hw3 and stress scene files mutated), the limits
+//! checked before any allocation, and the command line writing to a full disk, a
+//! read-only folder or `/dev/full`, or interrupted by SIGINT: exit 1, no partial file.
+
+mod robust_support;
+
+use std::cell::RefCell;
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use proptest::prelude::*;
+use robust_support::cases::runner;
+use robust_support::*;
+use whitted::render::Renderer;
+use whitted::scene::{self, limits, ImageSettings, Scene};
+
+const PATH: &str = "fuzz.toml";
+
+#[derive(Default, Debug)]
+struct Fuzzed {
+    inputs: u64,
+    accepted: u64,
+    rejected: u64,
+    with_line_col: u64,
+}
+
+/// Loads `text` both ways (streamed spheres and whole document): the two agree, an
+/// error is one line that starts with the path, and an accepted scene renders a tiny
+/// image with both tracers without a panic or a non-finite pixel.
+fn check_input(text: &str, stats: &RefCell<Fuzzed>) -> Result<(), TestCaseError> {
+    let streamed = Scene::from_toml_str(text, PATH);
+    let whole = Scene::from_toml_str_whole(text, PATH);
+    let mut s = stats.borrow_mut();
+    s.inputs += 1;
+    match (&streamed, &whole) {
+        (Ok(a), Ok(b)) => {
+            prop_assert_eq!(a, b, "the two parsing paths disagree");
+            s.accepted += 1;
+            let mut scene = a.clone();
+            scene.image.max_depth = scene.image.max_depth.min(4);
+            for renderer in [Renderer::Fast, Renderer::Reference] {
+                let img = render_with(&scene, 4, 3, renderer);
+                // Non-finite samples are zeroed before they reach a file: count only.
+                prop_assert_eq!(img.rgb.len(), 36);
+            }
+        }
+        (Err(e), Err(_)) => {
+            s.rejected += 1;
+            let line = e.to_string();
+            prop_assert!(!line.contains('\n'), "multi-line error: {line:?}");
+            prop_assert!(e.location.starts_with(PATH), "no location: {line:?}");
+            prop_assert!(!e.message.trim().is_empty(), "empty message");
+            let rest = &e.location[PATH.len()..];
+            if let Some(line_col) = rest.strip_prefix(':') {
+                s.with_line_col += 1;
+                let parts: Vec<&str> = line_col.split(':').collect();
+                prop_assert!(
+                    parts.len() == 2
+                        && parts.iter().all(|p| p.parse::<u32>().is_ok_and(|n| n >= 1)),
+                    "bad line:column in {line:?}"
+                );
+            }
+        }
+        _ => prop_assert!(
+            false,
+            "streamed {:?} but whole {:?}",
+            streamed.as_ref().map(|_| "ok"),
+            whole.as_ref().map(|_| "ok")
+        ),
+    }
+    Ok(())
+}
+
+/// Replacement values for numbers: non-finite, out of range, too large, wrong type.
+const BAD_NUMBERS: &[&str] = &[
+    "nan",
+    "inf",
+    "-inf",
+    "+nan",
+    "-1",
+    "0",
+    "-0.0",
+    "1e400",
+    "-1e400",
+    "1e-400",
+    "99999999999999999999",
+    "9223372036854775807",
+    "-9223372036854775808",
+    "4294967296",
+    "65537",
+    "1e308",
+    "0x10",
+    "1_000",
+    "\"1\"",
+    "true",
+    "[]",
+    "[1, 2]",
+    "{}",
+    "1979-05-27",
+];
+
+/// One edit of a text: flip a byte, delete a range, duplicate a range, or replace the
+/// number at a position by a bad one.
+#[derive(Clone, Debug)]
+enum Mutation {
+    Flip(usize, u8),
+    Delete(usize, usize),
+    Duplicate(usize, usize),
+    BadNumber(usize, usize),
+}
+
+fn mutation() -> impl Strategy<Value = Mutation> {
+    prop_oneof![
+        (any::<usize>(), any::<u8>()).prop_map(|(i, b)| Mutation::Flip(i, b)),
+        (any::<usize>(), 1usize..64).prop_map(|(i, n)| Mutation::Delete(i, n)),
+        (any::<usize>(), 1usize..200).prop_map(|(i, n)| Mutation::Duplicate(i, n)),
+        (any::<usize>(), 0..BAD_NUMBERS.len()).prop_map(|(i, k)| Mutation::BadNumber(i, k)),
+    ]
+}
+
+fn mutate(text: &str, edits: &[Mutation]) -> String {
+    let mut bytes = text.as_bytes().to_vec();
+    for m in edits {
+        if bytes.is_empty() {
+            break;
+        }
+        let len = bytes.len();
+        match *m {
+            Mutation::Flip(i, b) => bytes[i % len] = b,
+            Mutation::Delete(i, n) => {
+                let i = i % len;
+                bytes.drain(i..(i + n).min(len));
+            }
+            Mutation::Duplicate(i, n) => {
+                let i = i % len;
+                let piece = bytes[i..(i + n).min(len)].to_vec();
+                bytes.splice(i..i, piece);
+            }
+            Mutation::BadNumber(i, k) => {
+                // The number starting at or after position i, if any.
+                let Some(start) = (i % len..len).find(|&j| {
+                    bytes[j].is_ascii_digit() && (j == 0 || !bytes[j - 1].is_ascii_alphanumeric())
+                }) else {
+                    continue;
+                };
+                let start = if start > 0 && bytes[start - 1] == b'-' {
+                    start - 1
+                } else {
+                    start
+                };
+                let end = (start + 1..len)
+                    .find(|&j| !(bytes[j].is_ascii_digit() || b".eE+-".contains(&bytes[j])))
+                    .unwrap_or(len);
+                bytes.splice(start..end, BAD_NUMBERS[k].bytes());
+            }
+        }
+    }
+    // Scene text is a &str: invalid UTF-8 from a flip is replaced (the file loader
+    // rejects it before parsing, tested below).
+    String::from_utf8_lossy(&bytes).into_owned()
+}
+
+/// TOML-like token soup: keys and headers of the scene format, brackets, numbers.
+fn token_soup() -> impl Strategy<Value = String> {
+    let token = prop_oneof![
+        Just("[[sphere]]\n"),
+        Just("[[light]]\n"),
+        Just("[image]\n"),
+        Just("[camera]\n"),
+        Just("[sky]\n"),
+        Just("center = "),
+        Just("radius = "),
+        Just("color = "),
+        Just("reflect = "),
+        Just("transmit = "),
+        Just("ior = "),
+        Just("width = "),
+        Just("height = "),
+        Just("spp = "),
+        Just("max_depth = "),
+        Just("look_from = "),
+        Just("look_at = "),
+        Just("vfov = "),
+        Just("position = "),
+        Just("["),
+        Just("]"),
+        Just("{"),
+        Just("}"),
+        Just(", "),
+        Just("\n"),
+        Just("1"),
+        Just("0.5"),
+        Just("-2"),
+        Just("[0, 0, -1]"),
+        Just("[1, 1, 1]"),
+        Just("\"\"\""),
+        Just("# c\n"),
+        Just("nan"),
+        Just("1e400"),
+    ];
+    prop::collection::vec(token, 0..60).prop_map(|t| t.concat())
+}
+
+#[test]
+fn the_loader_never_panics_and_every_error_is_one_located_line() {
+    let stats = RefCell::new(Fuzzed::default());
+    // 1. Arbitrary text.
+    runner(3000)
+        .run(&any::<String>(), |t| check_input(&t, &stats))
+        .unwrap_or_else(|e| panic!("{e}"));
+    // 2. Token soup.
+    runner(5000)
+        .run(&token_soup(), |t| check_input(&t, &stats))
+        .unwrap_or_else(|e| panic!("{e}"));
+    // 3. The hw3 scene file and the stress scenes, mutated.
+    let mut bases = vec![scene::hw3_toml(scene::HW3_DEFAULT_SEED)];
+    for s in stress_scenes() {
+        bases.push(stress_text(&s));
+    }
+    let bases = &bases;
+    runner(20_000)
+        .run(
+            &(0..bases.len(), prop::collection::vec(mutation(), 1..6)),
+            |(k, edits)| check_input(&mutate(&bases[k], &edits), &stats),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+    // 4. A scene of 1300 spheres (three batches of the streamed parser), mutated: the
+    //    two paths agree on accepting, and on a bad value give the very same message.
+    let mut many = scene::hw3_scene(scene::HW3_DEFAULT_SEED);
+    let balls = many.spheres.clone();
+    for k in 0..24 {
+        many.spheres.extend(balls.iter().map(|b| {
+            let mut b = *b;
+            b.center.x += 4.0 * f64::from(k);
+            b
+        }));
+    }
+    let many = scene::to_toml(&many);
+    let same_error = RefCell::new((0u64, 0u64));
+    runner(300)
+        .run(&prop::collection::vec(mutation(), 1..3), |edits| {
+            let text = mutate(&many, &edits);
+            check_input(&text, &stats)?;
+            if let (Err(a), Err(b)) = (
+                Scene::from_toml_str(&text, PATH),
+                Scene::from_toml_str_whole(&text, PATH),
+            ) {
+                let mut n = same_error.borrow_mut();
+                n.0 += 1;
+                n.1 += u64::from(a == b);
+                // When the text parses, both report the first bad value (a syntax error
+                // later in the file may instead be what the whole-document parse sees).
+                if a.message.starts_with("sphere ") && b.message.starts_with("sphere ") {
+                    prop_assert_eq!(a, b);
+                }
+            }
+            Ok(())
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+    let (errors, same) = same_error.into_inner();
+    println!("1300-sphere scene mutated: {errors} errors, {same} identical from both paths");
+    let s = stats.into_inner();
+    println!(
+        "loader fuzz: {} inputs, {} accepted (rendered 4x3 with both tracers), {} rejected \
+         ({} with line:column, the rest with the file name only)",
+        s.inputs, s.accepted, s.rejected, s.with_line_col
+    );
+    assert!(s.inputs >= 28_300);
+    assert!(
+        s.accepted > 100 && s.rejected > 1000,
+        "both outcomes exercised: {s:?}"
+    );
+}
+
+/// An error from `text`, which must be refused.
+fn refused(text: &str) -> scene::SceneError {
+    match Scene::from_toml_str(text, PATH) {
+        Ok(_) => panic!("accepted: {}", &text[..text.len().min(200)]),
+        Err(e) => {
+            assert!(!e.to_string().contains('\n'));
+            e
+        }
+    }
+}
+
+#[test]
+fn image_limits_are_refused_with_a_located_message() {
+    let e = refused("[image]\nwidth = 100000\n");
+    assert_eq!(e.location, "fuzz.toml:2:9");
+    assert!(
+        e.message.contains("width") && e.message.contains("65536"),
+        "{e}"
+    );
+    // Each side within its limit, the product beyond 2^28 pixels: no buffer is made.
+    let e = refused("# big\n[image]\nwidth = 65536\nheight = 65536\n");
+    assert!(e.location.starts_with("fuzz.toml:2:"), "{e}");
+    assert!(e.message.contains("268435456 pixels"), "{e}");
+    for text in [
+        "[image]\nspp = 0\n",
+        "[image]\nspp = 65537\n",
+        "[image]\nmax_depth = 65\n",
+        "[image]\nheight = -1\n",
+        "[image]\nwidth = 99999999999999999999\n",
+        "[image]\nwidth = 1e12\n",
+    ] {
+        // The value's own position: line 2, after the key.
+        let e = refused(text);
+        let col = text[8..].find('=').unwrap() + 3;
+        assert_eq!(e.location, format!("fuzz.toml:2:{col}"), "{text:?}: {e}");
+        println!("{text:?} -> {e}");
+    }
+    // The settings check itself, at the edge.
+    let ok = ImageSettings {
+        width: 16384,
+        height: 16384,
+        ..Default::default()
+    };
+    assert!(ok.check().is_ok());
+    let over = ImageSettings {
+        height: 16385,
+        ..ok
+    };
+    assert!(over.check().unwrap_err().contains("pixels"));
+    assert!(ImageSettings {
+        max_depth: 65,
+        ..ok
+    }
+    .check()
+    .is_err());
+    assert!(ImageSettings {
+        max_depth: 64,
+        ..ok
+    }
+    .check()
+    .is_ok());
+}
+
+#[test]
+fn too_many_spheres_are_refused_before_parsing() {
+    let one = "[[sphere]]\ncenter = [0, 0, 0]\nradius = 1\n";
+    let n = limits::MAX_SPHERES + 1;
+    let text = one.repeat(n);
+    let start = Instant::now();
+    let e = refused(&text);
+    let seconds = start.elapsed().as_secs_f64();
+    println!(
+        "{} [[sphere]] tables ({} MB): refused in {seconds:.3} s: {e}",
+        n,
+        text.len() / 1_000_000
+    );
+    assert_eq!(
+        e.location,
+        format!("fuzz.toml:{}:1", 3 * limits::MAX_SPHERES + 1)
+    );
+    assert!(
+        e.message.contains("[[sphere]]") && e.message.contains("limit"),
+        "{e}"
+    );
+    // The same spheres inline: beyond the size parsed as one document.
+    let inline = format!(
+        "sphere = [{}]\n",
+        "{center = [0, 0, 0], radius = 1},".repeat(n)
+    );
+    let e = refused(&inline);
+    assert!(e.message.contains("[[sphere]] tables"), "{e}");
+    // Lights inline, few bytes each: refused by the bounded array, with a location.
+    let lights = format!("light = [{}]\n", "{},".repeat(limits::MAX_LIGHTS + 1));
+    let e = refused(&lights);
+    assert!(e.location.starts_with("fuzz.toml:1:"), "{e}");
+    assert!(e.message.contains("1024 lights"), "{e}");
+    // At the limit it loads (streamed), and fast.
+    let at_limit = Scene::from_toml_str(&one.repeat(1000), PATH).unwrap();
+    assert_eq!(at_limit.spheres.len(), 1000);
+}
+
+#[test]
+fn files_too_large_or_not_text_are_refused_before_reading() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = dir.path().join("big.toml");
+    // A sparse file: no disk space, but its size says it all.
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(limits::MAX_FILE_BYTES + 1)
+        .unwrap();
+    let e = Scene::load(&big).unwrap_err();
+    assert!(
+        e.message.contains("bytes") && e.message.contains("limit"),
+        "{e}"
+    );
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, b"[image]\nwidth = 3\xff\n").unwrap();
+    let e = Scene::load(&bad).unwrap_err();
+    assert!(e.message.contains("UTF-8"), "{e}");
+    let e = Scene::load(&dir.path().join("missing.toml")).unwrap_err();
+    assert!(e.to_string().contains("missing.toml"), "{e}");
+}
+
+fn whitted() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_whitted"))
+}
+
+/// Files left in `dir`.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Runs `script` in `sh` inside new user and mount namespaces (so it may mount a tmpfs
+/// without privileges and the mount vanishes with it); `None` if that is not possible.
+fn in_mount_namespace(script: &str) -> Option<std::process::Output> {
+    let probe = Command::new("unshare")
+        .args(["-rm", "true"])
+        .stderr(Stdio::null())
+        .status();
+    if !probe.is_ok_and(|s| s.success()) {
+        return None;
+    }
+    Some(
+        Command::new("unshare")
+            .args(["-rm", "sh", "-c", script])
+            .output()
+            .unwrap(),
+    )
+}
+
+/// A full disk (a 64 KiB tmpfs) and a read-only folder (a read-only tmpfs): exit 1,
+/// one error line, and the folder is left empty.
+#[test]
+fn a_full_disk_or_a_read_only_folder_leaves_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mnt = dir.path().display().to_string();
+    let bin = env!("CARGO_BIN_EXE_whitted");
+    for (what, options) in [
+        ("full disk", "size=64k"),
+        ("read-only folder", "ro,size=64k"),
+    ] {
+        // A plain PPM of 320x180 is about 500 KB: it cannot fit in 64 KiB.
+        let script = format!(
+            "mount -t tmpfs -o {options} tmpfs '{mnt}' || exit 99; \
+             '{bin}' render --width 320 --height 180 --quiet -o '{mnt}/out.ppm' -o '{mnt}/out.png'; \
+             echo \"rc=$?\"; ls -A '{mnt}'"
+        );
+        let Some(out) = in_mount_namespace(&script) else {
+            eprintln!("SKIPPED ({what}): cannot create user/mount namespaces (unshare -rm) here");
+            continue;
+        };
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        println!("{what}: stdout {stdout:?} stderr {stderr:?}");
+        if out.status.code() == Some(99) {
+            eprintln!("SKIPPED ({what}): cannot mount a tmpfs in a namespace: {stderr}");
+            continue;
+        }
+        let mut lines = stdout.lines();
+        assert_eq!(lines.next(), Some("rc=1"), "{what}: exit status");
+        assert_eq!(lines.next(), None, "{what}: files left behind: {stdout}");
+        let errors: Vec<&str> = stderr.lines().collect();
+        assert_eq!(errors.len(), 1, "{what}: one error line: {stderr}");
+        assert!(errors[0].starts_with("whitted: error: "), "{stderr}");
+    }
+    // A file-size limit (RLIMIT_FSIZE, SIGXFSZ ignored) fails writes like a full disk,
+    // without privileges.
+    let out = Command::new("sh")
+        .args([
+            "-c",
+            &format!(
+                "trap '' XFSZ; ulimit -f 16; exec '{bin}' render --width 320 --height 180 \
+                 --quiet -o '{}/out.ppm'",
+                dir.path().display()
+            ),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("file-size limit: {:?} {stderr:?}", out.status.code());
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+}
+
+/// `-o /dev/full`: a path with no image extension is a usage error (exit 2) found
+/// before any work; a path under it (`/dev/full/out.png`, not a folder) fails to create
+/// the temporary file: exit 1. One line each, nothing left in /dev. Writing through a
+/// device node with an image name is in `robust_failing.rs`.
+#[test]
+fn writing_to_dev_full_fails_cleanly() {
+    let before = listing(Path::new("/dev"));
+    for (target, code) in [("/dev/full", 2), ("/dev/full/out.png", 1)] {
+        let out = whitted()
+            .args([
+                "render", "--width", "32", "--height", "18", "--quiet", "-o", target,
+            ])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        println!("{target}: {:?} {stderr:?}", out.status.code());
+        assert_eq!(out.status.code(), Some(code), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains("/dev/full"), "{stderr}");
+    }
+    assert_eq!(listing(Path::new("/dev")), before, "nothing left in /dev");
+}
+
+/// SIGINT during a long render (the f64 reference, 64 spp at 1280x720): exit 1 with one
+/// line, and neither the image nor a temporary file is left.
+#[test]
+fn an_interrupted_render_leaves_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = whitted()
+        .args([
+            "render",
+            "--reference",
+            "--spp",
+            "64",
+            "--width",
+            "1280",
+            "--height",
+            "720",
+        ])
+        .arg("-o")
+        .arg(dir.path().join("out.png"))
+        .arg("-o")
+        .arg(dir.path().join("out.ppm"))
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Long enough for the interrupt handler to be in place and the render under way.
+    std::thread::sleep(Duration::from_millis(1500));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the render ended too early to interrupt"
+    );
+    let sent = Instant::now();
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let out = child.wait_with_output().unwrap();
+    let stopped = sent.elapsed().as_secs_f64();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!(
+        "SIGINT: stopped {stopped:.2} s after the signal: {:?} {stderr:?}",
+        out.status.code()
+    );
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+}
+
+/// A giant image from the command line or from the file is refused before anything is
+/// allocated (65536² pixels of 12 bytes would be 51 GB: an attempt would abort, not
+/// print one line and exit 1).
+#[test]
+fn giant_images_are_refused_by_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("giant.toml");
+    std::fs::write(&scene, "[image]\nwidth = 65536\nheight = 65536\n").unwrap();
+    let out_file = dir.path().join("out.png");
+    let runs: [Vec<&std::ffi::OsStr>; 2] = [
+        ["render", "--width", "65536", "--height", "65536", "-o"]
+            .iter()
+            .map(std::ffi::OsStr::new)
+            .chain([out_file.as_os_str()])
+            .collect(),
+        ["render"]
+            .iter()
+            .map(std::ffi::OsStr::new)
+            .chain([scene.as_os_str(), "-o".as_ref(), out_file.as_os_str()])
+            .collect(),
+    ];
+    for args in runs {
+        let out = whitted().args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        println!("{args:?}: {:?} {stderr:?}", out.status.code());
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains("268435456 pixels"), "{stderr}");
+    }
+    assert!(!out_file.exists());
+}

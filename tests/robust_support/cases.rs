@@ -1,0 +1,323 @@
+//! The random cases of the intersection tests, shared by `robust_intersect.rs` (truth:
+//! the query's own rounded ray) and `robust_failing.rs` (truth: the unrounded ray).
+
+use std::cell::RefCell;
+
+use std::ops::Sub;
+
+use glam::DVec3;
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+use whitted::accel::Spheres;
+use whitted::model::{self, Side};
+use whitted::scene::Sphere;
+
+use super::*;
+
+/// What the fast path's answer is compared with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Truth {
+    /// The ray the query holds (its `f32` direction promoted), computed in `f64`: the
+    /// error of the intersection maths alone.
+    QueryRay,
+    /// The `f64` ray before it was rounded into the query: the error a user sees.
+    Unrounded,
+}
+
+pub fn runner(cases: u32) -> TestRunner {
+    TestRunner::new_with_rng(
+        Config {
+            cases,
+            failure_persistence: None,
+            ..Config::default()
+        },
+        TestRng::deterministic_rng(RngAlgorithm::ChaCha),
+    )
+}
+
+/// A sphere of radius 10^U(−3,5) with its centre 10^U(−2,4) from the origin, an eye
+/// r·10^U(0.01,3) from the centre, and a point of the ball to aim at.
+pub fn sphere_and_eye() -> impl Strategy<Value = (DVec3, f64, DVec3, DVec3)> {
+    (
+        log_uniform(-3.0, 5.0),
+        log_uniform(-2.0, 4.0),
+        unit_vector(),
+        log_uniform(0.01, 3.0),
+        unit_vector(),
+        unit_vector(),
+        0.0f64..0.9,
+    )
+        .prop_map(|(r, dist_c, dir_c, eye_k, dir_eye, dir_aim, aim_k)| {
+            let c = dir_c * dist_c;
+            (c, r, c + dir_eye * (r * eye_k), c + dir_aim * (r * aim_k))
+        })
+}
+
+#[derive(Default, Debug)]
+pub struct ReHits {
+    pub spheres: u64,
+    pub primary_misses: u64,
+    pub outward: u64,
+    pub outward_rehits: u64,
+    pub shadow: u64,
+    pub shadowed: u64,
+    pub inward: u64,
+    pub inward_misses: u64,
+    pub max_rel_t: f64,
+}
+
+/// pbrt's TestReintersectConvex for spheres, through the fast path: `spheres` random
+/// spheres; from the hit of a ray coming from a random distance, 32 outward rays (one of
+/// them the mirror reflection, the others random down to 1e-6 from the tangent plane)
+/// must never meet their own sphere, 32 shadow rays toward random points outside must
+/// not be shadowed by it, and 32 inward rays must find the far exit with t within 1e-5
+/// (relative) of the `f64` value; 0 misses. Returns the figures, or the first failure
+/// (shrunk by proptest) with the figures so far.
+pub fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
+    let stats = RefCell::new(ReHits::default());
+    let spawn = prop::collection::vec((unit_vector(), log_uniform(-3.0, 3.0)), 32);
+    let result = runner(spheres).run(&(sphere_and_eye(), spawn), |((c, r, eye, aim), dirs)| {
+        let set = Spheres::new(&[Sphere::new(c, r)]);
+        let mut s = stats.borrow_mut();
+        s.spheres += 1;
+        let primary = query(eye, aim - eye, None);
+        let Some(hit) = set.closest(&primary) else {
+            // The f32 direction can miss a ball that is tiny next to its distance;
+            // counted, and nothing to spawn from.
+            s.primary_misses += 1;
+            return Ok(());
+        };
+        prop_assert!(hit.entering, "an eye outside the ball enters it");
+        let n = hit.normal;
+        let d = query_ray(&primary).1;
+        for (k, &(u, far)) in dirs.iter().enumerate() {
+            // Outward: the reflection first, then random, some nearly tangent.
+            let out = if k == 0 {
+                model::reflect(d, n).normalize()
+            } else {
+                in_hemisphere(n, u, 1e-6)
+            };
+            s.outward += 1;
+            if set
+                .closest(&query(hit.point, out, Some((0, Side::Outward))))
+                .is_some()
+            {
+                s.outward_rehits += 1;
+            }
+            // A shadow ray toward a point outside, r·10^U(−3,3) away.
+            let to = in_hemisphere(n, u, 1e-3) * (r * far);
+            s.shadow += 1;
+            if set.shadow(&query(hit.point, to, Some((0, Side::Outward))), to.length()) < 1.0 {
+                s.shadowed += 1;
+            }
+            // Inward: the far side, at least 1e-2 from the tangent plane.
+            let inward = in_hemisphere(-n, u, 1e-2);
+            let q = query(hit.point, inward, Some((0, Side::Inward)));
+            let (o, dq) = match truth {
+                Truth::QueryRay => query_ray(&q),
+                Truth::Unrounded => (hit.point, inward),
+            };
+            s.inward += 1;
+            let expected = roots64(o, dq, c, r)
+                .map(|(_, far)| far)
+                .filter(|t| *t > 0.0);
+            match (set.closest(&q), expected) {
+                (Some(exit), Some(t_ref)) => {
+                    prop_assert_eq!(exit.sphere, 0);
+                    prop_assert!(!exit.entering, "an inward ray leaves the ball");
+                    let t = (exit.point - o).dot(dq);
+                    let rel = (t - t_ref).abs() / t_ref;
+                    s.max_rel_t = s.max_rel_t.max(rel);
+                    prop_assert!(
+                        rel <= 1e-5,
+                        "r {r:e}, |c| {:e}: exit t {t} vs f64 {t_ref}: relative error {rel:e}",
+                        c.length()
+                    );
+                }
+                // A grazing line that misses at f64 precision: so does the fast path.
+                (None, None) if truth == Truth::QueryRay => {}
+                (got, want) => {
+                    s.inward_misses += 1;
+                    prop_assert!(
+                        false,
+                        "r {r:e}, |c| {:e}: exit {got:?} but f64 says {want:?}",
+                        c.length()
+                    );
+                }
+            }
+        }
+        prop_assert_eq!(s.outward_rehits, 0, "an outward ray met its own sphere");
+        prop_assert_eq!(s.shadowed, 0, "a shadow ray was shadowed by its own sphere");
+        Ok(())
+    });
+    let s = stats.into_inner();
+    println!(
+        "re-intersection ({truth:?}): {} spheres tried ({} primary misses at f32 resolution); \
+         outward rays {} re-hits {}; shadow rays {} shadowed {}; inward rays {} misses {} \
+         max rel. error of t {:.2e}",
+        s.spheres,
+        s.primary_misses,
+        s.outward,
+        s.outward_rehits,
+        s.shadow,
+        s.shadowed,
+        s.inward,
+        s.inward_misses,
+        s.max_rel_t
+    );
+    result.map(|()| s).map_err(|e| e.to_string())
+}
+
+/// Hit or miss, fast path against `f64`: rays from an eye near the origin aimed within
+/// 2r of a ball `dist` away. Returns (rays, wrong).
+pub fn hit_miss(truth: Truth, r: f64, dist: f64, rays: u32) -> (u64, u64) {
+    let counts = RefCell::new((0u64, 0u64));
+    let case = (
+        log_uniform(-2.0, 1.0),
+        unit_vector(),
+        unit_vector(),
+        unit_vector(),
+        0.0f64..1.0,
+    );
+    runner(rays)
+        .run(&case, |(eye_dist, eye_dir, view, off, k)| {
+            let eye = eye_dir * eye_dist;
+            let c = eye + view * dist;
+            // A point within 2r of the centre, across the view, uniform over the disc.
+            let across = (off - view * off.dot(view)).normalize_or(view.any_orthonormal_vector());
+            let aim = c + across * (2.0 * r * k.sqrt());
+            let q = query(eye, aim - eye, None);
+            let (o, d) = match truth {
+                Truth::QueryRay => query_ray(&q),
+                Truth::Unrounded => (eye, (aim - eye).normalize()),
+            };
+            let want = roots64(o, d, c, r).is_some_and(|(near, far)| near > 0.0 || far > 0.0);
+            let got = Spheres::new(&[Sphere::new(c, r)]).closest(&q).is_some();
+            let mut n = counts.borrow_mut();
+            n.0 += 1;
+            n.1 += u64::from(got != want);
+            Ok(())
+        })
+        .unwrap();
+    let (n, wrong) = counts.into_inner();
+    println!(
+        "hit/miss ({truth:?}) r={r:e} at {dist:e}: {wrong} wrong of {n} ({:.3}%)",
+        100.0 * wrong as f64 / n as f64
+    );
+    (n, wrong)
+}
+
+/// A ground of `radius` seen from 0.5 above its top, at depressions from just past the
+/// horizon to 0.1 rad beyond it, eyes within 10 of the top: the relative error of the
+/// hit's t. Returns (rays, median, max).
+pub fn ground_grazing(truth: Truth, radius: f64) -> (u64, f64, f64) {
+    let h = 0.5;
+    let c = DVec3::new(0.0, -h - radius, 0.0);
+    let horizon = (2.0 * h / radius).sqrt();
+    let errors = RefCell::new(Vec::new());
+    let case = (
+        log_uniform(-6.0, -1.0),
+        0.0f64..std::f64::consts::TAU,
+        (-10.0f64..10.0, -10.0f64..10.0),
+    );
+    runner(5000)
+        .run(&case, |(past, azimuth, (x, z))| {
+            let depression = horizon * (1.0 + past) + past;
+            let eye = DVec3::new(x, 0.0, z);
+            let dir = DVec3::new(
+                depression.cos() * azimuth.cos(),
+                -depression.sin(),
+                depression.cos() * azimuth.sin(),
+            );
+            let q = query(eye, dir, None);
+            let (o, d) = match truth {
+                Truth::QueryRay => query_ray(&q),
+                Truth::Unrounded => (eye, dir),
+            };
+            let Some((t_ref, _)) = roots64(o, d, c, radius) else {
+                return Ok(());
+            };
+            let hit = Spheres::new(&[Sphere::new(c, radius)]).closest(&q);
+            // t along the measured ray to the fast path's hit point.
+            if let Some(hit) = hit {
+                errors
+                    .borrow_mut()
+                    .push((hit.point - o).dot(d).sub(t_ref).abs() / t_ref);
+            } else {
+                errors.borrow_mut().push(f64::INFINITY);
+            }
+            Ok(())
+        })
+        .unwrap();
+    let mut e = errors.into_inner();
+    e.sort_by(f64::total_cmp);
+    let (n, median, max) = (e.len() as u64, e[e.len() / 2], *e.last().unwrap());
+    println!(
+        "ground r={radius:e} grazing ({truth:?}): {n} rays, rel. error of t median {median:.2e} max {max:.2e}"
+    );
+    (n, median, max)
+}
+
+/// An index of refraction 1 + 10^U(−3, 0.2) (1.001 to 2.58).
+pub fn ior() -> impl Strategy<Value = f64> {
+    log_uniform(-3.0, 0.2).prop_map(|x| 1.0 + x)
+}
+
+/// sin of the angle between two vectors, in `f64`.
+pub fn sin_between(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length() / (a.length() * b.length())
+}
+
+/// Entry/exit symmetry through the fast queries: a ray refracted into a ball leaves it
+/// at the angle it came in at (the chord makes equal angles with both normals):
+/// |sin θ_out − sin θ_in| ≤ 1e-5. Balls of radius 10^U(−3,5) with |centre| up to 1e4,
+/// those with |centre| > `max_centre_over_radius`·r left out. Returns (max error, balls).
+pub fn refraction_symmetry(max_centre_over_radius: f64) -> Result<(f64, u64), String> {
+    let worst = RefCell::new((0.0f64, 0u64));
+    let result = runner(5_000)
+        .run(&(sphere_and_eye(), ior()), |((c, r, eye, aim), ior)| {
+            if c.length() > max_centre_over_radius * r {
+                return Ok(());
+            }
+            let set = Spheres::new(&[Sphere::new(c, r)]);
+            let primary = query(eye, aim - eye, None);
+            let Some(hit) = set.closest(&primary) else {
+                return Ok(());
+            };
+            let d = primary.dir;
+            let (inside, crosses) = model::transmit(d, hit.normal.as_vec3(), true, ior as f32);
+            if !crosses {
+                // Rounding can make k < 0 at grazing entry; then it reflects (tested below).
+                return Ok(());
+            }
+            let q = query(hit.point, inside.as_dvec3(), Some((0, Side::Inward)));
+            let exit = set.closest(&q);
+            prop_assert!(exit.is_some(), "the refracted ray must find the exit");
+            let exit = exit.unwrap();
+            prop_assert!(!exit.entering);
+            let (out, crosses) = model::transmit(q.dir, exit.normal.as_vec3(), false, ior as f32);
+            prop_assert!(out.is_finite());
+            prop_assert!(
+                crosses,
+                "a chord's exit angle equals its entry angle: no TIR"
+            );
+            let sin_in = sin_between(d.as_dvec3(), hit.normal);
+            let sin_out = sin_between(out.as_dvec3(), exit.normal);
+            let err = (sin_out - sin_in).abs();
+            let mut w = worst.borrow_mut();
+            w.0 = w.0.max(err);
+            w.1 += 1;
+            prop_assert!(
+                err <= 1e-5,
+                "r {r:e} |c| {:e}: sin in {sin_in} out {sin_out}",
+                c.length()
+            );
+            Ok(())
+        })
+        .map_err(|e| e.to_string());
+    let (err, n) = worst.into_inner();
+    println!(
+        "entry/exit symmetry (|c| ≤ {max_centre_over_radius:e} r): {n} balls, max |sin θout − sin θin| {err:.2e}"
+    );
+    result.map(|()| (err, n))
+}
