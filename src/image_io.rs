@@ -3,7 +3,7 @@
 //! written whole or not at all: into a temporary file beside the target, then renamed.
 
 use std::io::{Cursor, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use image::codecs::bmp::BmpEncoder;
 use image::codecs::jpeg::JpegEncoder;
@@ -152,6 +152,24 @@ fn temp_file_for(path: &Path) -> Result<tempfile::NamedTempFile, SaveError> {
     })
 }
 
+/// What a path to save to really is.
+enum Target {
+    /// A regular file, or nothing yet: replaced atomically at this path. A symbolic
+    /// link is resolved first, so that it keeps pointing at the new image.
+    File(PathBuf),
+    /// An existing device, FIFO or socket: it cannot be replaced (and must not be:
+    /// renaming over `/dev/full` would swallow the error), so it is written in place.
+    Special,
+}
+
+fn target_of(path: &Path) -> Target {
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() && !m.is_dir() => Target::Special,
+        Ok(_) => Target::File(std::fs::canonicalize(path).unwrap_or_else(|_| path.into())),
+        Err(_) => Target::File(path.into()),
+    }
+}
+
 /// Fails unless a file can be created in the folder of `path`: lets a command refuse
 /// an unwritable target before it spends time rendering. Leaves nothing behind.
 pub fn check_writable(path: &Path) -> Result<(), SaveError> {
@@ -161,22 +179,39 @@ pub fn check_writable(path: &Path) -> Result<(), SaveError> {
             message: "is a folder".into(),
         });
     }
-    temp_file_for(path).map(drop)
+    match target_of(path) {
+        // Opening a FIFO would wait for a reader: the write will tell.
+        Target::Special => Ok(()),
+        Target::File(real) => temp_file_for(&real).map(drop),
+    }
 }
 
 /// Writes `bytes` into `path` atomically: a temporary file in the same folder, flushed
 /// and synced, then renamed over the target. On any error nothing is left behind (the
-/// temporary file deletes itself when dropped).
+/// temporary file deletes itself when dropped). A device or FIFO is written in place.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
     let err = |message: String| SaveError {
         path: path.display().to_string(),
         message,
     };
-    let mut temp = temp_file_for(path)?;
-    temp.write_all(bytes).map_err(|e| err(e.to_string()))?;
-    temp.as_file().sync_all().map_err(|e| err(e.to_string()))?;
-    temp.persist(path).map_err(|e| err(e.error.to_string()))?;
-    Ok(())
+    match target_of(path) {
+        Target::Special => {
+            let mut file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(path)
+                .map_err(|e| err(e.to_string()))?;
+            file.write_all(bytes)
+                .and_then(|()| file.flush())
+                .map_err(|e| err(e.to_string()))
+        }
+        Target::File(real) => {
+            let mut temp = temp_file_for(&real)?;
+            temp.write_all(bytes).map_err(|e| err(e.to_string()))?;
+            temp.as_file().sync_all().map_err(|e| err(e.to_string()))?;
+            temp.persist(&real).map_err(|e| err(e.error.to_string()))?;
+            Ok(())
+        }
+    }
 }
 
 /// The frame encoded in `format`.

@@ -303,3 +303,70 @@ fn the_committed_readme_image_is_the_hw3_render() {
         off.iter().max()
     );
 }
+
+#[test]
+fn a_symbolic_link_keeps_pointing_at_the_new_image() {
+    let frame = library_frame();
+    let dir = tempfile::tempdir().unwrap();
+    let images = dir.path().join("images");
+    std::fs::create_dir(&images).unwrap();
+    let real = images.join("real.png");
+    std::fs::write(&real, b"old").unwrap();
+    let link = dir.path().join("link.png");
+    std::os::unix::fs::symlink(&real, &link).unwrap();
+
+    image_io::save(&frame, &link, Format::Png).unwrap();
+    // The link is still a link to the same file, which now holds the image; the
+    // temporary file went into the real file's folder and is gone.
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(std::fs::read_link(&link).unwrap(), real);
+    assert!(image::open(&real).unwrap().into_rgb8() == image_io::to_rgb8(&frame));
+    assert_eq!(entries(&images), ["real.png"]);
+}
+
+#[test]
+fn a_fifo_receives_the_image_in_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.ppm");
+    let made = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    if !made {
+        eprintln!("SKIPPED: a_fifo_receives_the_image_in_place: mkfifo failed here");
+        return;
+    }
+    // A reader on the other end, as in `whitted render -o pipe.ppm & viewer pipe.ppm`.
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(fifo).unwrap())
+    };
+    whitted(&[
+        "render",
+        "--quiet",
+        "--ppm-binary",
+        "--width",
+        &W.to_string(),
+        "--height",
+        &H.to_string(),
+        "-o",
+        fifo.to_str().unwrap(),
+    ]);
+    // Still a FIFO, and nothing else in the folder. (Checked first: had the FIFO been
+    // replaced, the reader would wait forever, and joining it would hang the test.)
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::symlink_metadata(&fifo)
+            .unwrap()
+            .file_type()
+            .is_fifo(),
+        "the FIFO was replaced by a file"
+    );
+    assert_eq!(entries(dir.path()), ["pipe.ppm"]);
+    let bytes = reader.join().unwrap();
+    let decoded = image::load_from_memory(&bytes).unwrap().into_rgb8();
+    assert!(decoded == image_io::to_rgb8(&library_frame()));
+}
