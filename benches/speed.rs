@@ -53,7 +53,8 @@ fn kernel(c: &mut Criterion) {
         })
     });
     let lights = [scene.lights[0].position];
-    let gridded = Spheres::new(&scene.spheres).with_grids(DVec3::ZERO, &lights);
+    let gridded = Spheres::new(&scene.spheres).with_light_grids(&lights);
+    let eye = gridded.eye_grid(DVec3::ZERO);
     c.bench_function("accel/closest_primary_grid_hw3_4096_rays", |b| {
         b.iter(|| {
             let mut hits = 0;
@@ -63,7 +64,7 @@ fn kernel(c: &mut Criterion) {
                     dir,
                     from: None,
                 };
-                hits += gridded.closest_primary(&q).is_some() as u32;
+                hits += gridded.closest_primary(&eye, &q).is_some() as u32;
             }
             black_box(hits)
         })
@@ -78,7 +79,10 @@ fn build(c: &mut Criterion) {
         let cam = whitted::Camera::for_scene(&scene, 1280, 720).expect("camera");
         let lights: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
         group.bench_function(format!("bvh_and_grids_many_{n}"), |b| {
-            b.iter(|| black_box(Spheres::new(&scene.spheres).with_grids(cam.origin, &lights)))
+            b.iter(|| {
+                let spheres = Spheres::new(&scene.spheres).with_light_grids(&lights);
+                black_box(spheres.eye_grid(cam.origin))
+            })
         });
     }
     group.finish();

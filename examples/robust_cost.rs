@@ -106,7 +106,8 @@ fn main() {
     // Per query, through accel (BVH; the eye grid for primaries).
     let eye_only = Spheres::new(&scene.spheres);
     let lights: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
-    let gridded = Spheres::new(&scene.spheres).with_grids(o64, &lights);
+    let gridded = Spheres::new(&scene.spheres).with_light_grids(&lights);
+    let eye = gridded.eye_grid(o64);
     let primary = |d: Vec3| Query {
         origin: o64,
         dir: d,
@@ -123,7 +124,7 @@ fn main() {
     });
     let t_primary_grid = time(dirs.len(), || {
         dirs.iter()
-            .filter_map(|&d| gridded.closest_primary(&primary(d)))
+            .filter_map(|&d| gridded.closest_primary(&eye, &primary(d)))
             .count() as f64
     });
     // Spawned reflected rays: the own-sphere rule, t_min and the re-projected origin.

@@ -194,6 +194,9 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
         path: path.display().to_string(),
         message,
     };
+    if path.is_dir() {
+        return Err(err("is a folder".into()));
+    }
     match target_of(path) {
         Target::Special => {
             let mut file = std::fs::OpenOptions::new()

@@ -222,8 +222,7 @@ fn entries(dir: &Path) -> Vec<String> {
 fn a_failed_save_leaves_nothing_behind() {
     let frame = library_frame();
     let dir = tempfile::tempdir().unwrap();
-    // The target is an existing folder: the temporary file is written, the rename
-    // fails, and the temporary file must go.
+    // The target is an existing folder: refused, and nothing is created beside it.
     let target = dir.path().join("taken.png");
     std::fs::create_dir(&target).unwrap();
     let err = image_io::save(&frame, &target, Format::Png).unwrap_err();

@@ -102,7 +102,8 @@ fn culling_never_loses_a_hit_or_an_occluder() {
             |(spheres, eye_dist, eye_dir, light_dir, rays)| {
                 let eye = eye_dir * eye_dist;
                 let light = light_dir * (eye_dist * 3.0);
-                let set = Spheres::new(&spheres).with_grids(eye, &[light]);
+                let set = Spheres::new(&spheres).with_light_grids(&[light]);
+                let eye_grid = set.eye_grid(eye);
                 let mut c = counts.borrow_mut();
                 for &(u, pick, spread) in &rays {
                     // Aimed within 1.3 radii of a random sphere's centre: hits, misses
@@ -130,7 +131,7 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                     let want = sorted.first().map(|x| x.0 as u32);
                     for (name, got) in [
                         ("closest", set.closest(&q)),
-                        ("closest_primary", set.closest_primary(&q)),
+                        ("closest_primary", set.closest_primary(&eye_grid, &q)),
                     ] {
                         let got_k = got.map(|h| h.sphere);
                         if got_k != want {

@@ -487,7 +487,7 @@ fn a_full_disk_or_a_read_only_folder_leaves_no_file() {
 /// `-o /dev/full`: a path with no image extension is a usage error (exit 2) found
 /// before any work; a path under it (`/dev/full/out.png`, not a folder) fails to create
 /// the temporary file: exit 1. One line each, nothing left in /dev. Writing through a
-/// device node with an image name is in `robust_failing.rs`.
+/// device node with an image name is in `robust_output_device.rs`.
 #[test]
 fn writing_to_dev_full_fails_cleanly() {
     let before = listing(Path::new("/dev"));

@@ -103,22 +103,6 @@ impl DirGrid {
         }
     }
 
-    pub fn debug_stats(&self) {
-        let cells = self.offsets.len() - 1;
-        let nonempty = (0..cells)
-            .filter(|&c| self.offsets[c + 1] > self.offsets[c])
-            .count();
-        let max = (0..cells)
-            .map(|c| self.offsets[c + 1] - self.offsets[c])
-            .max()
-            .unwrap_or(0);
-        eprintln!(
-            "cells {cells} nonempty {nonempty} items {} max {max} always {}",
-            self.items.len(),
-            self.always.len()
-        );
-    }
-
     /// The cell of direction `d` (any length, not zero).
     #[inline]
     pub fn cell(&self, d: Vec3) -> usize {
@@ -224,7 +208,7 @@ impl SphereCone {
 
 /// A face-coordinate vector (u, v, w along the face's outward axis) in world axes.
 fn from_face(face: u32, f: DVec3) -> DVec3 {
-    let w = if face % 2 == 0 { f.z } else { -f.z };
+    let w = if face.is_multiple_of(2) { f.z } else { -f.z };
     match face / 2 {
         0 => DVec3::new(w, f.x, f.y),
         1 => DVec3::new(f.x, w, f.y),
@@ -247,7 +231,7 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
         _ => (0, 1),
     };
     // Coordinates with the face's axis pointing outwards.
-    let (a_lo, a_hi) = if face % 2 == 0 {
+    let (a_lo, a_hi) = if face.is_multiple_of(2) {
         (lo[axis], hi[axis])
     } else {
         (-hi[axis], -lo[axis])

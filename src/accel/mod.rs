@@ -83,6 +83,9 @@ fn grid_resolution(spheres: usize) -> u32 {
     }
 }
 
+/// A directional grid around a camera origin (see [`Spheres::eye_grid`]).
+pub struct EyeGrid(DirGrid);
+
 /// The spheres, for the fast tracer's queries.
 pub struct Spheres {
     center: Vec<DVec3>,
@@ -90,8 +93,6 @@ pub struct Spheres {
     /// `f32` centre and radius, the radius widened to cover the centre's rounding.
     quick: Vec<Vec4>,
     bvh: Bvh,
-    /// Around the camera origin, for primary rays.
-    eye: Option<DirGrid>,
     /// Around each light, for shadow rays.
     lights: Vec<DirGrid>,
 }
@@ -143,36 +144,35 @@ impl Spheres {
             center,
             radius,
             quick,
-            eye: None,
             lights: Vec::new(),
         }
     }
 
-    /// Adds directional grids around the camera origin and each light, so primary and
-    /// shadow rays test only the spheres seen in their direction.
-    pub fn with_grids(mut self, eye: DVec3, lights: &[DVec3]) -> Self {
-        let list: Vec<(DVec3, f64)> = self
-            .center
+    fn centres_and_radii(&self) -> Vec<(DVec3, f64)> {
+        self.center
             .iter()
             .copied()
             .zip(self.radius.iter().copied())
-            .collect();
+            .collect()
+    }
+
+    /// Adds a directional grid around each light, so that shadow rays test only the
+    /// spheres seen in their direction from the light.
+    pub fn with_light_grids(mut self, lights: &[DVec3]) -> Self {
+        let list = self.centres_and_radii();
         let n = grid_resolution(list.len());
-        // All grids at once: they are independent.
-        let points: Vec<DVec3> = std::iter::once(eye).chain(lights.iter().copied()).collect();
-        let mut grids: Vec<DirGrid> = points
+        self.lights = lights
             .par_iter()
             .map(|&p| DirGrid::build(p, &list, n))
             .collect();
-        self.lights = grids.split_off(1);
-        self.eye = grids.pop();
         self
     }
 
-    pub fn debug_stats(&self) {
-        for g in self.eye.iter().chain(&self.lights) {
-            g.debug_stats();
-        }
+    /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
+    /// the only part of the structures that depends on the camera.
+    pub fn eye_grid(&self, eye: DVec3) -> EyeGrid {
+        let list = self.centres_and_radii();
+        EyeGrid(DirGrid::build(eye, &list, grid_resolution(list.len())))
     }
 
     pub fn len(&self) -> usize {
@@ -210,7 +210,7 @@ impl Spheres {
         // The direction renormalised in `f64`: the exact tests assume `d·d = 1`, which
         // an `f32`-normalised direction misses by up to ~1e-7. Done here, for the few
         // spheres that pass the quick test, not for every ray.
-        let (o, d, t_min) = (ray.o64, ray.d32.as_dvec3().normalize(), ray.t_min);
+        let (o, d, t_min) = (ray.o64, renormalize(ray.d32.as_dvec3()), ray.t_min);
         let (c, r) = (self.center[k], self.radius[k]);
         let own = ray
             .from
@@ -254,7 +254,7 @@ impl Spheres {
         if best.k == usize::MAX {
             return None;
         }
-        let normal = best.normal.normalize();
+        let normal = renormalize(best.normal);
         Some(Hit {
             sphere: best.k as u32,
             point: self.center[best.k] + normal * self.radius[best.k],
@@ -274,11 +274,12 @@ impl Spheres {
         self.finish(best)
     }
 
-    /// The closest hit of a primary ray (its origin is the camera's).
-    pub fn closest_primary(&self, q: &Query) -> Option<Hit> {
-        let Some(grid) = self.eye.as_ref().filter(|g| g.centre == q.origin) else {
+    /// The closest hit of a primary ray: a ray from the centre of `eye`.
+    pub fn closest_primary(&self, eye: &EyeGrid, q: &Query) -> Option<Hit> {
+        let grid = &eye.0;
+        if grid.centre != q.origin {
             return self.closest(q);
-        };
+        }
         let ray = Ray::new(q);
         let mut best = Best::NONE;
         for &k in &grid.always {
@@ -354,6 +355,20 @@ impl Best {
         entering: false,
         normal: DVec3::ZERO,
     };
+}
+
+/// A vector within ~1e-6 of unit length scaled to unit length in `f64` without a square
+/// root or a division: with `δ = v·v − 1`, `1/√(1+δ) = 1 − δ/2 + 3δ²/8 − …`, and the
+/// terms left out are below 1e-18. (Directions normalised in `f32`, and normals built
+/// from the roots, are that close.) Anything farther is normalised the usual way.
+#[inline(always)]
+fn renormalize(v: DVec3) -> DVec3 {
+    let delta = v.dot(v) - 1.0;
+    if delta.abs() < 1e-6 {
+        v * (1.0 - delta * (0.5 - 0.375 * delta))
+    } else {
+        v.normalize()
+    }
 }
 
 /// `t` as an `f32` no smaller than it.

@@ -484,10 +484,10 @@ fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
     let mut sky = Sky::default();
     if let Some(s) = &file.sky {
         if let Some(v) = &s.down {
-            sky.down = colour(at, v, "sky.down")?;
+            sky.down = colour(at, v, &"sky.down")?;
         }
         if let Some(v) = &s.up {
-            sky.up = colour(at, v, "sky.up")?;
+            sky.up = colour(at, v, &"sky.up")?;
         }
     }
 
@@ -499,10 +499,26 @@ fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
             for (k, l) in list.iter().enumerate() {
                 let mut light = Light::default();
                 if let Some(v) = &l.position {
-                    light.position = finite(at, v, &format!("light {}: position", k + 1))?;
+                    light.position = finite(
+                        at,
+                        v,
+                        &Field {
+                            table: "light",
+                            index: k,
+                            key: "position",
+                        },
+                    )?;
                 }
                 if let Some(v) = &l.intensity {
-                    light.intensity = finite(at, v, &format!("light {}: intensity", k + 1))?;
+                    light.intensity = finite(
+                        at,
+                        v,
+                        &Field {
+                            table: "light",
+                            index: k,
+                            key: "intensity",
+                        },
+                    )?;
                     if light.intensity.min_element() < 0.0 {
                         return Err(
                             at.at(v.span(), format!("light {}: intensity must be >= 0", k + 1))
@@ -525,40 +541,58 @@ fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
     })
 }
 
+/// Names a value in messages ("sphere 3: radius"), formatted only when an error needs it.
+struct Field<'a> {
+    table: &'a str,
+    /// Number of the table in its array, from 0.
+    index: usize,
+    key: &'a str,
+}
+
+impl std::fmt::Display for Field<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {}: {}", self.table, self.index + 1, self.key)
+    }
+}
+
 /// Sphere number `k` (from 0), validated.
 fn sphere(at: &Locator, s: &FileSphere, k: usize) -> Result<Sphere, SceneError> {
-    let who = format!("sphere {}", k + 1);
-    let center = finite(at, &s.center, &format!("{who}: center"))?;
-    let radius = number(at, &s.radius, &format!("{who}: radius"))?;
+    let field = |key| Field {
+        table: "sphere",
+        index: k,
+        key,
+    };
+    let center = finite(at, &s.center, &field("center"))?;
+    let radius = number(at, &s.radius, &field("radius"))?;
     if radius <= 0.0 {
         return Err(at.at(
             s.radius.span(),
-            format!("{who}: radius must be > 0, got {radius}"),
+            format!("sphere {}: radius must be > 0, got {radius}", k + 1),
         ));
     }
     let mut sphere = Sphere::new(center, radius);
     if let Some(v) = &s.color {
-        sphere.color = colour(at, v, &format!("{who}: color"))?;
+        sphere.color = colour(at, v, &field("color"))?;
     }
     if let Some(v) = &s.reflect {
-        sphere.reflect = weight(at, v, &format!("{who}: reflect"))?;
+        sphere.reflect = weight(at, v, &field("reflect"))?;
     }
     if let Some(v) = &s.transmit {
-        sphere.transmit = weight(at, v, &format!("{who}: transmit"))?;
+        sphere.transmit = weight(at, v, &field("transmit"))?;
     }
     if let Some(v) = &s.ior {
-        sphere.ior = number(at, v, &format!("{who}: ior"))?;
+        sphere.ior = number(at, v, &field("ior"))?;
         if sphere.ior < 1.0 {
             return Err(at.at(
                 v.span(),
-                format!("{who}: ior must be >= 1, got {}", sphere.ior),
+                format!("sphere {}: ior must be >= 1, got {}", k + 1, sphere.ior),
             ));
         }
     }
     Ok(sphere)
 }
 
-fn number(at: &Locator, v: &Num, what: &str) -> Result<f64, SceneError> {
+fn number(at: &Locator, v: &Num, what: &dyn std::fmt::Display) -> Result<f64, SceneError> {
     let x = *v.get_ref();
     if x.is_finite() {
         Ok(x)
@@ -567,7 +601,7 @@ fn number(at: &Locator, v: &Num, what: &str) -> Result<f64, SceneError> {
     }
 }
 
-fn finite(at: &Locator, v: &V3, what: &str) -> Result<DVec3, SceneError> {
+fn finite(at: &Locator, v: &V3, what: &dyn std::fmt::Display) -> Result<DVec3, SceneError> {
     let a = *v.get_ref();
     if a.iter().all(|x| x.is_finite()) {
         Ok(DVec3::from_array(a))
@@ -579,7 +613,7 @@ fn finite(at: &Locator, v: &V3, what: &str) -> Result<DVec3, SceneError> {
     }
 }
 
-fn colour(at: &Locator, v: &V3, what: &str) -> Result<DVec3, SceneError> {
+fn colour(at: &Locator, v: &V3, what: &dyn std::fmt::Display) -> Result<DVec3, SceneError> {
     let c = finite(at, v, what)?;
     if c.min_element() < 0.0 || c.max_element() > 1.0 {
         return Err(at.at(
@@ -590,7 +624,7 @@ fn colour(at: &Locator, v: &V3, what: &str) -> Result<DVec3, SceneError> {
     Ok(c)
 }
 
-fn weight(at: &Locator, v: &Num, what: &str) -> Result<f64, SceneError> {
+fn weight(at: &Locator, v: &Num, what: &dyn std::fmt::Display) -> Result<f64, SceneError> {
     let w = number(at, v, what)?;
     if !(0.0..=1.0).contains(&w) {
         return Err(at.at(v.span(), format!("{what} must lie in [0, 1], got {w}")));
@@ -646,7 +680,7 @@ fn camera(at: &Locator, c: &Spanned<FileCamera>) -> Result<CameraSpec, SceneErro
             up: v3(&cam.up, up, "up")?,
             vfov: match &cam.vfov {
                 None => vfov,
-                Some(v) => number(at, v, "camera.vfov")?,
+                Some(v) => number(at, v, &"camera.vfov")?,
             },
         }
     };

@@ -2,10 +2,12 @@
 //! scene compiled once ([`crate::accel`]) and the intersection maths in `f64` where
 //! `f32` cannot hold.
 
+use std::sync::Arc;
+
 use glam::{DVec3, Vec3};
 
 use super::{RayCounts, SampleTracer};
-use crate::accel::{Query, Spheres};
+use crate::accel::{EyeGrid, Query, Spheres};
 use crate::camera::Camera;
 use crate::model::{self, Branches, Side};
 use crate::scene::Scene;
@@ -25,12 +27,21 @@ struct Light {
     intensity: Vec3,
 }
 
-pub struct FastTracer {
+/// The scene compiled for the fast tracer: everything that does not depend on the
+/// camera, shared by the tracers of every view (the viewer builds it once).
+struct Compiled {
     spheres: Spheres,
     materials: Vec<Material>,
     lights: Vec<Light>,
     sky_down: Vec3,
     sky_up: Vec3,
+    value_bound: f32,
+}
+
+pub struct FastTracer {
+    compiled: Arc<Compiled>,
+    /// The camera-dependent part of the acceleration structures.
+    eye: EyeGrid,
     origin: DVec3,
     /// `LL − O`, rounded once from `f64`.
     corner: Vec3,
@@ -39,9 +50,6 @@ pub struct FastTracer {
     max_depth: u32,
     /// Contribution cutoff: a branch whose path weight is below it is not traced.
     cutoff: f32,
-    /// An upper bound of any traced colour component (SPEC §2 colours are convex mixes
-    /// of sky colours and light sums), to turn skipped weight into an error bound.
-    value_bound: f32,
 }
 
 /// What a sample skipped under the contribution cutoff.
@@ -52,11 +60,9 @@ struct Skipped {
 
 impl FastTracer {
     pub fn new(scene: &Scene, camera: &Camera, max_depth: u32) -> Self {
-        FastTracer {
-            spheres: Spheres::new(&scene.spheres).with_grids(
-                camera.origin,
-                &scene.lights.iter().map(|l| l.position).collect::<Vec<_>>(),
-            ),
+        let lights: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
+        let compiled = Compiled {
+            spheres: Spheres::new(&scene.spheres).with_light_grids(&lights),
             materials: scene
                 .spheres
                 .iter()
@@ -78,14 +84,28 @@ impl FastTracer {
                 .collect(),
             sky_down: scene.sky.down.as_vec3(),
             sky_up: scene.sky.up.as_vec3(),
+            value_bound: value_bound(scene),
+        };
+        Self::with_compiled(Arc::new(compiled), camera, max_depth)
+    }
+
+    fn with_compiled(compiled: Arc<Compiled>, camera: &Camera, max_depth: u32) -> Self {
+        FastTracer {
+            eye: compiled.spheres.eye_grid(camera.origin),
+            compiled,
             origin: camera.origin,
             corner: (camera.lower_left - camera.origin).as_vec3(),
             horizontal: camera.horizontal.as_vec3(),
             vertical: camera.vertical.as_vec3(),
             max_depth,
             cutoff: 0.0,
-            value_bound: value_bound(scene),
         }
+    }
+
+    /// The same scene seen by another camera (and depth): shares the compiled scene and
+    /// rebuilds only the camera's grid, so views of one scene compile it once.
+    pub fn with_camera(&self, camera: &Camera, max_depth: u32) -> Self {
+        Self::with_compiled(Arc::clone(&self.compiled), camera, max_depth).with_cutoff(self.cutoff)
     }
 
     /// Skip every branch whose path weight (the product of the mix weights of step 7
@@ -117,7 +137,7 @@ impl FastTracer {
         skipped: &mut Skipped,
     ) -> Vec3 {
         if depth >= self.max_depth {
-            return model::sky(ray.dir, self.sky_down, self.sky_up);
+            return model::sky(ray.dir, self.compiled.sky_down, self.compiled.sky_up);
         }
         if depth == 0 {
             counts.primary += 1;
@@ -125,14 +145,14 @@ impl FastTracer {
             counts.secondary += 1;
         }
         let hit = if depth == 0 {
-            self.spheres.closest_primary(ray)
+            self.compiled.spheres.closest_primary(&self.eye, ray)
         } else {
-            self.spheres.closest(ray)
+            self.compiled.spheres.closest(ray)
         };
         let Some(hit) = hit else {
-            return model::sky(ray.dir, self.sky_down, self.sky_up);
+            return model::sky(ray.dir, self.compiled.sky_down, self.compiled.sky_up);
         };
-        let m = &self.materials[hit.sphere as usize];
+        let m = &self.compiled.materials[hit.sphere as usize];
         let front = hit.entering;
         let n = hit.normal.as_vec3();
         let nf = if front { n } else { -n };
@@ -145,7 +165,7 @@ impl FastTracer {
         let mut local = Vec3::ZERO;
         let w_local = weight * (1.0 - m.w_t) * (1.0 - m.w_r);
         if m.branches.local && self.keep(w_local, skipped) {
-            for (index, light) in self.lights.iter().enumerate() {
+            for (index, light) in self.compiled.lights.iter().enumerate() {
                 // From the f64 point, which lies on the sphere.
                 let to_light = light.position - hit.point;
                 let dist = to_light.length();
@@ -153,7 +173,10 @@ impl FastTracer {
                 let cos = nf.dot(l);
                 if cos > 0.0 {
                     counts.shadow += 1;
-                    let shadow = self.spheres.shadow_to_light(&spawn(l, !front), dist, index);
+                    let shadow =
+                        self.compiled
+                            .spheres
+                            .shadow_to_light(&spawn(l, !front), dist, index);
                     local += model::diffuse(m.color, light.intensity, cos, shadow);
                 }
             }
@@ -204,6 +227,6 @@ impl SampleTracer for FastTracer {
         };
         let mut skipped = Skipped::default();
         let colour = self.trace(&ray, 0, 1.0, counts, &mut skipped);
-        (colour, skipped.weight * self.value_bound)
+        (colour, skipped.weight * self.compiled.value_bound)
     }
 }

@@ -37,6 +37,166 @@ struct Hit {
     entering: bool,
 }
 
+/// Which way a ray of the ray tree was cast.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    Primary,
+    Reflect,
+    Transmit,
+}
+
+impl RayKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            RayKind::Primary => "primary",
+            RayKind::Reflect => "reflect",
+            RayKind::Transmit => "transmit",
+        }
+    }
+}
+
+/// Where a recorded ray hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HitRecord {
+    pub sphere: usize,
+    pub point: DVec3,
+    pub normal: DVec3,
+    /// The ray enters the sphere here (near root).
+    pub entering: bool,
+}
+
+/// One shadow ray towards a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowRecord {
+    pub light: usize,
+    /// The occluder that set the shadow factor (the smallest one), if any.
+    pub occluder: Option<usize>,
+    /// The shadow factor `s` of step 4.
+    pub factor: f64,
+    /// This light's diffuse term `kd ⊙ I · cos · s`.
+    pub colour: DVec3,
+    /// The weight of that term in the pixel.
+    pub weight: f64,
+}
+
+/// One ray of a ray tree, with what it hit, its shadow rays and its children.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RayNode {
+    pub kind: RayKind,
+    pub depth: u32,
+    pub origin: DVec3,
+    pub dir: DVec3,
+    /// The weight of this ray's colour in the pixel (the product of the mixing weights
+    /// of step 7 along the path).
+    pub weight: f64,
+    /// `None`: the ray saw the sky (or reached the depth limit).
+    pub hit: Option<HitRecord>,
+    /// The ray was not traced because `depth ≥ max_depth`: its colour is the sky's.
+    pub depth_limited: bool,
+    pub shadows: Vec<ShadowRecord>,
+    pub children: Vec<RayNode>,
+    /// The colour `trace` returned for this ray.
+    pub colour: DVec3,
+}
+
+/// Watches [`ReferenceTracer`] trace a ray. The no-op `()` is what rendering uses; the
+/// tracer calls it the same way either way, so recording cannot change a result.
+pub trait Recorder {
+    /// A ray starts; `mix` is its weight in its parent's colour (1 for a primary ray).
+    fn begin(&mut self, _kind: RayKind, _depth: u32, _origin: DVec3, _dir: DVec3, _mix: f64) {}
+    fn depth_limit(&mut self) {}
+    fn hit(&mut self, _hit: &HitRecord) {}
+    /// A shadow ray; `mix` is the weight of the local term in this ray's colour.
+    fn shadow(
+        &mut self,
+        _light: usize,
+        _occluder: Option<usize>,
+        _factor: f64,
+        _colour: DVec3,
+        _mix: f64,
+    ) {
+    }
+    /// The ray's colour is known.
+    fn end(&mut self, _colour: DVec3) {}
+}
+
+impl Recorder for () {}
+
+/// Builds the [`RayNode`] tree of one sample.
+#[derive(Default)]
+pub struct TreeRecorder {
+    stack: Vec<RayNode>,
+    root: Option<RayNode>,
+}
+
+impl TreeRecorder {
+    /// The tree recorded so far (the primary ray), once it has finished.
+    pub fn into_tree(self) -> Option<RayNode> {
+        self.root
+    }
+}
+
+impl Recorder for TreeRecorder {
+    fn begin(&mut self, kind: RayKind, depth: u32, origin: DVec3, dir: DVec3, mix: f64) {
+        let parent_weight = self.stack.last().map_or(1.0, |p| p.weight);
+        self.stack.push(RayNode {
+            kind,
+            depth,
+            origin,
+            dir,
+            weight: parent_weight * mix,
+            hit: None,
+            depth_limited: false,
+            shadows: Vec::new(),
+            children: Vec::new(),
+            colour: DVec3::ZERO,
+        });
+    }
+
+    fn depth_limit(&mut self) {
+        if let Some(node) = self.stack.last_mut() {
+            node.depth_limited = true;
+        }
+    }
+
+    fn hit(&mut self, hit: &HitRecord) {
+        if let Some(node) = self.stack.last_mut() {
+            node.hit = Some(*hit);
+        }
+    }
+
+    fn shadow(
+        &mut self,
+        light: usize,
+        occluder: Option<usize>,
+        factor: f64,
+        colour: DVec3,
+        mix: f64,
+    ) {
+        if let Some(node) = self.stack.last_mut() {
+            let weight = node.weight * mix;
+            node.shadows.push(ShadowRecord {
+                light,
+                occluder,
+                factor,
+                colour,
+                weight,
+            });
+        }
+    }
+
+    fn end(&mut self, colour: DVec3) {
+        let Some(mut node) = self.stack.pop() else {
+            return;
+        };
+        node.colour = colour;
+        match self.stack.last_mut() {
+            Some(parent) => parent.children.push(node),
+            None => self.root = Some(node),
+        }
+    }
+}
+
 /// The distance below which a spawned ray ignores *other* spheres: a few rounding
 /// errors of the spawn point's coordinates.
 fn spawn_tolerance(p: DVec3) -> f64 {
@@ -97,22 +257,51 @@ impl<'a> ReferenceTracer<'a> {
         })
     }
 
-    /// The shadow factor `s` of step 4 along the segment from the hit to the light.
-    fn shadow(&self, from: &Ray, dist: f64) -> f64 {
+    /// The shadow factor `s` of step 4 along the segment from the hit to the light,
+    /// and the occluder that set it.
+    fn shadow(&self, from: &Ray, dist: f64) -> (f64, Option<usize>) {
         let t_min = Self::t_min(from);
         let mut factor = 1.0f64;
+        let mut occluder = None;
         for (k, s) in self.scene.spheres.iter().enumerate() {
             if let Some((t, _)) = self.crossing(from, k, t_min, dist) {
                 let n_k = (from.origin + from.dir * t - s.center) / s.radius;
-                factor = factor.min(model::occluder_factor(from.dir, n_k));
+                let f = model::occluder_factor(from.dir, n_k);
+                if occluder.is_none() || f < factor {
+                    occluder = Some(k);
+                }
+                factor = factor.min(f);
             }
         }
-        factor
+        (factor, occluder)
     }
 
-    fn trace(&self, ray: &Ray, depth: u32, counts: &mut RayCounts) -> DVec3 {
+    /// [`Self::trace_ray`] between the recorder's `begin` and `end`.
+    fn trace<R: Recorder>(
+        &self,
+        ray: &Ray,
+        depth: u32,
+        counts: &mut RayCounts,
+        rec: &mut R,
+        kind: RayKind,
+        mix: f64,
+    ) -> DVec3 {
+        rec.begin(kind, depth, ray.origin, ray.dir, mix);
+        let colour = self.trace_ray(ray, depth, counts, rec);
+        rec.end(colour);
+        colour
+    }
+
+    fn trace_ray<R: Recorder>(
+        &self,
+        ray: &Ray,
+        depth: u32,
+        counts: &mut RayCounts,
+        rec: &mut R,
+    ) -> DVec3 {
         let sky = &self.scene.sky;
         if depth >= self.max_depth {
+            rec.depth_limit();
             return model::sky(ray.dir, sky.down, sky.up);
         }
         if depth == 0 {
@@ -123,6 +312,12 @@ impl<'a> ReferenceTracer<'a> {
         let Some(hit) = self.closest_hit(ray) else {
             return model::sky(ray.dir, sky.down, sky.up);
         };
+        rec.hit(&HitRecord {
+            sphere: hit.sphere,
+            point: hit.point,
+            normal: hit.normal,
+            entering: hit.entering,
+        });
         let s: &Sphere = &self.scene.spheres[hit.sphere];
         let front = hit.entering;
         let n = hit.normal;
@@ -134,29 +329,42 @@ impl<'a> ReferenceTracer<'a> {
             from: Some((hit.sphere, Side::inside(inside))),
         };
 
+        let local_mix = (1.0 - s.transmit) * (1.0 - s.reflect);
         let mut local = DVec3::ZERO;
         if branches.local {
-            for light in &self.scene.lights {
+            for (index, light) in self.scene.lights.iter().enumerate() {
                 let to_light = light.position - hit.point;
                 let dist = to_light.length();
                 let l = to_light / dist;
                 let cos = nf.dot(l);
                 if cos > 0.0 {
                     counts.shadow += 1;
-                    let shadow = self.shadow(&spawn(l, !front), dist);
-                    local += model::diffuse(s.color, light.intensity, cos, shadow);
+                    let (shadow, occluder) = self.shadow(&spawn(l, !front), dist);
+                    let term = model::diffuse(s.color, light.intensity, cos, shadow);
+                    rec.shadow(index, occluder, shadow, term, local_mix);
+                    local += term;
                 }
             }
         }
         let reflected = if branches.reflect {
             let dir = model::reflect(ray.dir, n).normalize();
-            self.trace(&spawn(dir, !front), depth + 1, counts)
+            let mix = (1.0 - s.transmit) * s.reflect;
+            let child = spawn(dir, !front);
+            self.trace(&child, depth + 1, counts, rec, RayKind::Reflect, mix)
         } else {
             DVec3::ZERO
         };
         let transmitted = if branches.transmit {
             let (dir, crosses) = model::transmit(ray.dir, n, front, s.ior);
-            self.trace(&spawn(dir, front == crosses), depth + 1, counts)
+            let child = spawn(dir, front == crosses);
+            self.trace(
+                &child,
+                depth + 1,
+                counts,
+                rec,
+                RayKind::Transmit,
+                s.transmit,
+            )
         } else {
             DVec3::ZERO
         };
@@ -165,6 +373,24 @@ impl<'a> ReferenceTracer<'a> {
 
     /// The linear colour of the ray through film position `(s, t)`, in `f64`.
     pub fn sample_f64(&self, s: f64, t: f64, counts: &mut RayCounts) -> DVec3 {
+        self.sample_recorded(s, t, counts, &mut ())
+    }
+
+    /// [`Self::sample_f64`] with its ray tree (for the viewer's pixel inspector).
+    pub fn inspect(&self, s: f64, t: f64) -> (DVec3, RayNode) {
+        let mut rec = TreeRecorder::default();
+        let colour = self.sample_recorded(s, t, &mut RayCounts::default(), &mut rec);
+        let tree = rec.into_tree().expect("the primary ray was recorded");
+        (colour, tree)
+    }
+
+    fn sample_recorded<R: Recorder>(
+        &self,
+        s: f64,
+        t: f64,
+        counts: &mut RayCounts,
+        rec: &mut R,
+    ) -> DVec3 {
         let c = &self.camera;
         let dir = model::primary_direction(c.lower_left - c.origin, c.horizontal, c.vertical, s, t);
         let ray = Ray {
@@ -172,7 +398,7 @@ impl<'a> ReferenceTracer<'a> {
             dir,
             from: None,
         };
-        self.trace(&ray, 0, counts)
+        self.trace(&ray, 0, counts, rec, RayKind::Primary, 1.0)
     }
 }
 

@@ -1,9 +1,472 @@
-//! The window (SPEC §6). Being written; see issue 3.
+//! The window (SPEC §6): winit for the window and input, `pixels` or `softbuffer` to
+//! show the image. This file is only the event loop; the parts with logic live in
+//! small modules tested without a window: [`controls`] (camera maths), [`schedule`]
+//! (progressive passes), [`worker`] (the render thread), [`buffer`] (the flip of the
+//! bottom-up frame into top-down screen bytes), [`save`] (numbered files),
+//! [`inspect`] (the pixel inspector) and [`status`] (title, keys, timings).
+//!
+//! The event loop never renders: it submits a job per view to the worker, which sends
+//! each finished pass back as a user event; the loop copies it to the window.
+
+pub mod blit;
+pub mod buffer;
+pub mod controls;
+pub mod inspect;
+pub mod save;
+pub mod schedule;
+pub mod status;
+pub mod worker;
+
+use std::path::Path;
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::Instant;
+
+use anyhow::{anyhow, bail};
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Window, WindowId};
 
 use crate::scene::Scene;
 
+use blit::{Blitter, Choice};
+use controls::{Action, CameraControl};
+use status::Progress;
+use worker::{Report, Shown, Worker};
+
+/// A press and release closer than this (pixels) is a click, not a drag.
+const CLICK_SLOP: f64 = 3.0;
+
 /// Opens the viewer on `scene` and returns when the window closes.
 pub fn run(scene: Scene) -> anyhow::Result<()> {
-    let _ = scene;
-    anyhow::bail!("the viewer is not built yet: use `whitted render`")
+    let started = Instant::now();
+    let choice = blit::parse_choice(std::env::var("WHITTED_BLIT").ok().as_deref())
+        .map_err(|e| anyhow!(e))?;
+    let stats = status::stats_enabled(std::env::var("WHITTED_STATS").ok().as_deref());
+    let has_display = ["DISPLAY", "WAYLAND_DISPLAY"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()));
+    let hint = "use `whitted render` to write the image to files instead";
+    if !has_display {
+        bail!("no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset); {hint}");
+    }
+    let event_loop = EventLoop::<Report>::with_user_event()
+        .build()
+        .map_err(|e| anyhow!("cannot open the display ({}); {hint}", winit_message(&e)))?;
+    event_loop.set_control_flow(ControlFlow::Wait);
+    let mut app = App::new(scene, event_loop.create_proxy(), choice, stats, started);
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
+    app.finish()
+}
+
+/// winit's error without the source location it prefixes to OS errors.
+fn winit_message(e: &dyn std::fmt::Display) -> String {
+    let text = e.to_string();
+    match text.split_once(": ") {
+        Some((location, message)) if location.starts_with("os error at ") => message.into(),
+        _ => text,
+    }
+}
+
+struct Drag {
+    start: (f64, f64),
+    last: (f64, f64),
+    moved: bool,
+}
+
+struct App {
+    scene: Arc<Scene>,
+    stem: String,
+    choice: Choice,
+    stats: bool,
+    started: Instant,
+    window: Option<Arc<Window>>,
+    blitter: Option<Blitter>,
+    worker: Worker,
+    camera: CameraControl,
+    /// The window's inner size (0×0 when minimised).
+    size: (u32, u32),
+    /// The size and scene (with the view's camera) of the current job.
+    job_size: (u32, u32),
+    job_scene: Arc<Scene>,
+    generation: u64,
+    progress: Progress,
+    /// What is on screen, and the scene it was rendered from.
+    shown: Option<(Shown, Arc<Scene>)>,
+    /// A new frame waits to be drawn.
+    fresh: bool,
+    cursor: Option<(f64, f64)>,
+    drag: Option<Drag>,
+    numbering: save::Numbering,
+    saves: Vec<JoinHandle<()>>,
+    first_frame_reported: bool,
+    /// Holds camera changes while the current view has nothing on screen.
+    throttle: schedule::Throttle,
+    /// Pixel samples per second of the last pass, to size the next preview.
+    speed: f64,
+    error: Option<anyhow::Error>,
+}
+
+impl App {
+    fn new(
+        scene: Scene,
+        proxy: EventLoopProxy<Report>,
+        choice: Choice,
+        stats: bool,
+        started: Instant,
+    ) -> App {
+        let scene = Arc::new(scene);
+        // The proxy wakes the event loop; after it has closed, reports are dropped.
+        let worker = Worker::spawn(move |report| {
+            let _ = proxy.send_event(report);
+        });
+        App {
+            stem: save::file_stem(&scene.name),
+            camera: CameraControl::new(&scene),
+            job_scene: Arc::clone(&scene),
+            scene,
+            choice,
+            stats,
+            started,
+            window: None,
+            blitter: None,
+            worker,
+            size: (0, 0),
+            job_size: (0, 0),
+            generation: 0,
+            progress: Progress::Rendering,
+            shown: None,
+            fresh: false,
+            cursor: None,
+            drag: None,
+            numbering: save::Numbering::default(),
+            saves: Vec::new(),
+            first_frame_reported: false,
+            throttle: schedule::Throttle::default(),
+            speed: f64::NAN,
+            error: None,
+        }
+    }
+
+    /// After the loop: waits for saves in flight, returns the error that ended it.
+    fn finish(mut self) -> anyhow::Result<()> {
+        self.worker.cancel();
+        for save in self.saves.drain(..) {
+            let _ = save.join();
+        }
+        match self.error.take() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
+        self.error = Some(error);
+        event_loop.exit();
+    }
+
+    /// Renders the current camera at the window size (unless minimised).
+    fn submit(&mut self) {
+        let (w, h) = self.size;
+        if w == 0 || h == 0 {
+            return;
+        }
+        self.generation += 1;
+        self.throttle.started();
+        let mut scene = (*self.scene).clone();
+        scene.camera = Some(self.camera.spec(&self.scene, w, h));
+        self.job_scene = Arc::new(scene);
+        self.job_size = (w, h);
+        self.progress = Progress::Rendering;
+        let factor = schedule::preview_factor(w, h, self.speed);
+        self.worker
+            .submit(self.generation, Arc::clone(&self.job_scene), (w, h), factor);
+        self.update_title();
+    }
+
+    fn update_title(&self) {
+        if let Some(window) = &self.window {
+            let (w, h) = self.job_size;
+            window.set_title(&status::title(&self.scene.name, w, h, &self.progress));
+        }
+    }
+
+    fn camera_action(&mut self, action: Action) {
+        let (w, h) = self.job_size;
+        if w > 0 && self.camera.apply(&self.scene, w, h, action) && self.throttle.changed() {
+            self.submit();
+        }
+    }
+
+    fn key(&mut self, event_loop: &ActiveEventLoop, event: &KeyEvent) {
+        if event.state != ElementState::Pressed {
+            return;
+        }
+        match &event.logical_key {
+            Key::Named(NamedKey::Escape) => event_loop.exit(),
+            Key::Named(NamedKey::ArrowUp) => self.camera_action(Action::Forward(1.0)),
+            Key::Named(NamedKey::ArrowDown) => self.camera_action(Action::Forward(-1.0)),
+            Key::Named(NamedKey::ArrowLeft) => self.camera_action(Action::Right(-1.0)),
+            Key::Named(NamedKey::ArrowRight) => self.camera_action(Action::Right(1.0)),
+            Key::Named(NamedKey::PageUp) => self.camera_action(Action::Lift(1.0)),
+            Key::Named(NamedKey::PageDown) => self.camera_action(Action::Lift(-1.0)),
+            Key::Character(c) => match c.to_ascii_lowercase().as_str() {
+                "q" => event_loop.exit(),
+                "s" if !event.repeat => self.save(),
+                "r" if self.camera.is_edited() => {
+                    self.camera.reset();
+                    self.submit();
+                }
+                "h" => println!("{}", status::HELP),
+                _ => {}
+            },
+            _ => {}
+        }
+    }
+
+    /// Saves what is on screen under new numbered names, on a thread of its own.
+    fn save(&mut self) {
+        let Some((shown, _)) = &self.shown else {
+            println!("nothing on screen to save yet");
+            return;
+        };
+        let frame = Arc::clone(&shown.frame);
+        let what = format!(
+            "{}x{}, {}/{} spp",
+            frame.width, frame.height, shown.samples, shown.target
+        );
+        let (png, ppm) = self
+            .numbering
+            .next(Path::new(""), &self.stem, |p| p.exists());
+        self.saves.push(std::thread::spawn(move || {
+            match save::save_pair(&frame, &png, &ppm) {
+                Ok(()) => println!("saved {} and {} ({what})", png.display(), ppm.display()),
+                Err(e) => eprintln!("whitted: cannot save: {e}"),
+            }
+        }));
+    }
+
+    /// Prints the ray tree of the pixel under the cursor, on a thread of its own.
+    fn inspect(&self, position: (f64, f64)) {
+        let (Some((shown, scene)), Some(blitter)) = (&self.shown, &self.blitter) else {
+            return;
+        };
+        let size = (shown.frame.width, shown.frame.height);
+        let Some((i, j)) = blitter.pixel_at(position, size, self.size) else {
+            return;
+        };
+        let value = shown.frame.get(i, j);
+        let scene = Arc::clone(scene);
+        std::thread::spawn(
+            move || match inspect::report(&scene, size.0, size.1, i, j, value) {
+                Ok(text) => print!("{text}"),
+                Err(e) => eprintln!("whitted: cannot inspect the pixel: {e}"),
+            },
+        );
+    }
+
+    fn frame_ready(&mut self, shown: Shown) {
+        if shown.generation != self.generation {
+            return; // a stale pass of a cancelled view
+        }
+        if shown.pass_seconds > 0.0 {
+            self.speed = shown.pass_pixels as f64 / shown.pass_seconds;
+        }
+        self.progress = if shown.preview {
+            Progress::Preview {
+                seconds: shown.pass_seconds,
+            }
+        } else {
+            Progress::Samples {
+                samples: shown.samples,
+                target: shown.target,
+                seconds: shown.pass_seconds,
+            }
+        };
+        self.shown = Some((shown, Arc::clone(&self.job_scene)));
+        self.fresh = true;
+        if let Some(window) = &self.window {
+            window.request_redraw();
+        }
+        if self.throttle.shown() {
+            self.submit();
+        }
+    }
+
+    fn redraw(&mut self) {
+        let (Some(blitter), Some((shown, _))) = (&mut self.blitter, &self.shown) else {
+            return;
+        };
+        if self.size.0 == 0 || self.size.1 == 0 {
+            return;
+        }
+        let start = Instant::now();
+        let (w, h) = (shown.frame.width, shown.frame.height);
+        if let Err(e) = blitter.draw(&shown.rgba, w, h) {
+            eprintln!("whitted: {e}");
+        }
+        let blit = start.elapsed().as_secs_f64();
+        if self.fresh {
+            self.fresh = false;
+            // The title changes only once the frame it describes is on screen, so a
+            // title ending in "done" means the window shows the finished image.
+            self.update_title();
+            if self.stats {
+                self.print_stats(blit);
+            }
+        }
+    }
+
+    fn print_stats(&mut self, blit: f64) {
+        let Some((shown, _)) = &self.shown else {
+            return;
+        };
+        let kind = if shown.preview { "preview" } else { "samples" };
+        eprintln!(
+            "stats: view {} {} {}x{} pass_pixels {} spp {}/{} render_ms {:.2} blit_ms {:.2} since_view_ms {:.2} since_start_ms {:.2}",
+            shown.generation,
+            kind,
+            shown.frame.width,
+            shown.frame.height,
+            shown.pass_pixels,
+            shown.samples,
+            shown.target,
+            shown.pass_seconds * 1e3,
+            blit * 1e3,
+            shown.since_submit * 1e3,
+            self.started.elapsed().as_secs_f64() * 1e3,
+        );
+        if !self.first_frame_reported {
+            self.first_frame_reported = true;
+            let blitter = self.blitter.as_ref().map_or("none", Blitter::name);
+            eprintln!("stats: blitter {blitter}");
+        }
+    }
+}
+
+impl ApplicationHandler<Report> for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_some() {
+            return;
+        }
+        let (w, h) = (self.scene.image.width, self.scene.image.height);
+        let attributes = Window::default_attributes()
+            .with_title(status::title(&self.scene.name, w, h, &Progress::Rendering))
+            .with_inner_size(PhysicalSize::new(w, h));
+        let window = match event_loop.create_window(attributes) {
+            Ok(window) => Arc::new(window),
+            Err(e) => {
+                return self.fail(event_loop, anyhow!("cannot open a window: {e}"));
+            }
+        };
+        let inner = window.inner_size();
+        self.size = (inner.width, inner.height);
+        let surface = if self.size.0 == 0 || self.size.1 == 0 {
+            (w, h)
+        } else {
+            self.size
+        };
+        self.window = Some(Arc::clone(&window));
+        // Render while the blitter starts up (wgpu takes a while to find its adapter).
+        self.submit();
+        match Blitter::new(&window, surface, self.choice) {
+            Ok(blitter) => self.blitter = Some(blitter),
+            Err(e) => self.fail(event_loop, anyhow!(e)),
+        }
+    }
+
+    fn user_event(&mut self, _event_loop: &ActiveEventLoop, report: Report) {
+        match report {
+            Report::Frame(shown) => self.frame_ready(shown),
+            Report::Failed {
+                generation,
+                message,
+            } => {
+                if generation == self.generation {
+                    eprintln!("whitted: cannot render this view: {message}");
+                    self.progress = Progress::Failed;
+                    self.update_title();
+                    if self.throttle.shown() {
+                        self.submit();
+                    }
+                }
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::RedrawRequested => self.redraw(),
+            WindowEvent::Resized(size) => {
+                self.size = (size.width, size.height);
+                if size.width == 0 || size.height == 0 {
+                    return; // minimised: keep everything until it comes back
+                }
+                if let Some(blitter) = &mut self.blitter {
+                    if let Err(e) = blitter.resize_surface(self.size) {
+                        eprintln!("whitted: {e}");
+                    }
+                }
+                if self.size != self.job_size {
+                    self.submit();
+                }
+                if let Some(window) = &self.window {
+                    window.request_redraw();
+                }
+            }
+            WindowEvent::KeyboardInput { event, .. } => self.key(event_loop, &event),
+            WindowEvent::CursorMoved { position, .. } => {
+                let now = (position.x, position.y);
+                self.cursor = Some(now);
+                if let Some(drag) = &mut self.drag {
+                    let (dx, dy) = (now.0 - drag.last.0, now.1 - drag.last.1);
+                    let far = (now.0 - drag.start.0).hypot(now.1 - drag.start.1);
+                    drag.moved |= far > CLICK_SLOP;
+                    if drag.moved {
+                        drag.last = now;
+                        let height = self.job_size.1;
+                        self.camera_action(Action::Drag { dx, dy, height });
+                    }
+                }
+            }
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => match state {
+                ElementState::Pressed => {
+                    if let Some(at) = self.cursor {
+                        self.drag = Some(Drag {
+                            start: at,
+                            last: at,
+                            moved: false,
+                        });
+                    }
+                }
+                ElementState::Released => {
+                    if let Some(drag) = self.drag.take() {
+                        if !drag.moved {
+                            self.inspect(drag.start);
+                        }
+                    }
+                }
+            },
+            WindowEvent::MouseWheel { delta, .. } => {
+                let steps = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => f64::from(y),
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                if steps != 0.0 {
+                    self.camera_action(Action::Zoom(steps));
+                }
+            }
+            _ => {}
+        }
+    }
 }

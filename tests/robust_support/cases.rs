@@ -1,5 +1,5 @@
-//! The random cases of the intersection tests, shared by `robust_intersect.rs` (truth:
-//! the query's own rounded ray) and `robust_failing.rs` (truth: the unrounded ray).
+//! The random cases of the intersection tests of `robust_intersect.rs`, measured against
+//! two truths: the query's own rounded ray, and the unrounded ray.
 
 use std::cell::RefCell;
 

@@ -1,20 +1,11 @@
-//! Issue 4 tests that the program does not pass yet, kept apart so that the owner of the
-//! code at fault can fix it and then move the test next to the others. Each test names
-//! its cause; the report of the `robust` branch has the figures.
-//!
-//! (Causes 1-3 of the first version of this file, in the fast path's precision, were
-//! fixed on main by 54e7bc6; their tests now live in robust_intersect.rs,
-//! robust_refract.rs and robust_scenes.rs.)
-//!
-//! 4. (`src/image_io.rs`) `write_atomically` renames its temporary file over whatever
-//!    the target is: a device node (or FIFO) named `out.png` is replaced by a regular
-//!    file and the command succeeds, where writing to a full device must fail with
-//!    exit 1 and leave the node alone.
+//! Output to a device: a render written to a full device fails with exit 1 and leaves
+//! the device alone (`image_io::write_atomically` writes into a target that exists and
+//! is not a regular file instead of renaming a temporary file over it).
 
-/// Cause 4: a render written to a device node that behaves like `/dev/full` (char 1,7,
+/// A render written to a device node that behaves like `/dev/full` (char 1,7,
 /// made with mknod under the name `out.png` in a temporary folder, so that the real
 /// /dev/full is never at risk): exit 1 with one line, the node left as it was, no other
-/// file. Today the node is replaced by a PNG file and the exit status is 0.
+/// file.
 #[test]
 fn writing_to_a_full_device_fails_and_leaves_it_alone() {
     use std::os::unix::fs::FileTypeExt;

@@ -1,0 +1,169 @@
+//! Pixel buffers for the screen. A [`Frame`] has row 0 at the BOTTOM (`j = 0`, as in
+//! GLUT); screens have row 0 at the top, so this is where the viewer flips it, once,
+//! with the same byte conversion as the files ([`to_byte`]) so that a screenshot at
+//! 1:1 equals the saved image.
+
+use crate::image_io::to_byte;
+use crate::render::Frame;
+
+use super::schedule::preview_source;
+
+/// The frame as RGBA bytes, row 0 at the top, alpha 255 (the layout of `pixels`).
+pub fn to_rgba_top_down(frame: &Frame) -> Vec<u8> {
+    let w = frame.width as usize;
+    let mut bytes = Vec::with_capacity(w * frame.height as usize * 4);
+    for row in frame.pixels.chunks_exact(w.max(1)).rev() {
+        for p in row {
+            bytes.extend_from_slice(&[to_byte(p.x), to_byte(p.y), to_byte(p.z), 255]);
+        }
+    }
+    bytes
+}
+
+/// A `width`×`height` frame showing `preview` (rendered at 1/`factor` of the size)
+/// with each of its pixels as a `factor`×`factor` block, anchored at the bottom-left
+/// like the image.
+pub fn upscale(preview: &Frame, factor: u32, width: u32, height: u32) -> Frame {
+    let mut frame = Frame::new(width, height);
+    for j in 0..height {
+        for i in 0..width {
+            let (pi, pj) = preview_source(i, j, factor);
+            let (pi, pj) = (pi.min(preview.width - 1), pj.min(preview.height - 1));
+            frame.pixels[(j * width + i) as usize] = preview.get(pi, pj);
+        }
+    }
+    frame
+}
+
+/// Where a `w`×`h` image sits, centred, in a `surface_w`×`surface_h` surface: the
+/// offset of its top-left corner (negative when the image is larger and is clipped).
+pub fn centre_offset(w: u32, h: u32, surface_w: u32, surface_h: u32) -> (i64, i64) {
+    (
+        (i64::from(surface_w) - i64::from(w)) / 2,
+        (i64::from(surface_h) - i64::from(h)) / 2,
+    )
+}
+
+/// Draws top-down RGBA `rgba` (`w`×`h`) centred into a softbuffer surface of
+/// `0x00RRGGBB` words, black around it.
+pub fn blit_xrgb(rgba: &[u8], w: u32, h: u32, dst: &mut [u32], surface_w: u32, surface_h: u32) {
+    dst.fill(0);
+    let (ox, oy) = centre_offset(w, h, surface_w, surface_h);
+    for y in 0..i64::from(h) {
+        let sy = y + oy;
+        if sy < 0 || sy >= i64::from(surface_h) {
+            continue;
+        }
+        for x in 0..i64::from(w) {
+            let sx = x + ox;
+            if sx < 0 || sx >= i64::from(surface_w) {
+                continue;
+            }
+            let s = ((y * i64::from(w) + x) * 4) as usize;
+            let (r, g, b) = (rgba[s] as u32, rgba[s + 1] as u32, rgba[s + 2] as u32);
+            dst[(sy * i64::from(surface_w) + sx) as usize] = (r << 16) | (g << 8) | b;
+        }
+    }
+}
+
+/// The image pixel `(i, j)` (`j` from the BOTTOM) under window position `(x, y)` (from
+/// the top-left), for an image of `w`×`h` centred 1:1 in a window of
+/// `surface_w`×`surface_h`; `None` outside the image.
+pub fn window_to_pixel(
+    x: f64,
+    y: f64,
+    w: u32,
+    h: u32,
+    surface_w: u32,
+    surface_h: u32,
+) -> Option<(u32, u32)> {
+    let (ox, oy) = centre_offset(w, h, surface_w, surface_h);
+    let ix = (x - ox as f64).floor();
+    let iy = (y - oy as f64).floor();
+    if ix < 0.0 || iy < 0.0 || ix >= f64::from(w) || iy >= f64::from(h) {
+        return None;
+    }
+    Some((ix as u32, h - 1 - iy as u32))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// A 3×2 frame whose pixels encode their coordinates.
+    fn frame() -> Frame {
+        let mut f = Frame::new(3, 2);
+        for j in 0..2 {
+            for i in 0..3 {
+                f.pixels[j * 3 + i] = Vec3::new(i as f32 / 255.0, j as f32 / 255.0, 1.0);
+            }
+        }
+        f
+    }
+
+    #[test]
+    fn rgba_puts_the_bottom_row_last() {
+        let rgba = to_rgba_top_down(&frame());
+        assert_eq!(rgba.len(), 3 * 2 * 4);
+        // Top-left of the screen is (i=0, j=1); bottom-right is (i=2, j=0).
+        assert_eq!(&rgba[0..4], &[0, 1, 255, 255]);
+        assert_eq!(&rgba[20..24], &[2, 0, 255, 255]);
+    }
+
+    #[test]
+    fn rgba_equals_the_file_bytes() {
+        let mut f = frame();
+        f.pixels[1] = Vec3::new(-1.0, 0.5, 2.0);
+        let rgb = crate::image_io::to_rgb8(&f);
+        let rgba = to_rgba_top_down(&f);
+        for (px, chunk) in rgb.pixels().zip(rgba.chunks_exact(4)) {
+            assert_eq!(&px.0, &chunk[..3]);
+            assert_eq!(chunk[3], 255);
+        }
+    }
+
+    #[test]
+    fn upscale_repeats_blocks_from_the_bottom_left() {
+        let preview = frame();
+        let big = upscale(&preview, 2, 5, 3);
+        assert_eq!(big.get(0, 0), preview.get(0, 0));
+        assert_eq!(big.get(1, 1), preview.get(0, 0));
+        assert_eq!(big.get(2, 1), preview.get(1, 0));
+        assert_eq!(big.get(4, 2), preview.get(2, 1));
+    }
+
+    #[test]
+    fn xrgb_centres_and_clears() {
+        let rgba = to_rgba_top_down(&frame());
+        let mut dst = vec![7u32; 5 * 4];
+        blit_xrgb(&rgba, 3, 2, &mut dst, 5, 4);
+        // Offset (1, 1): the image's top-left pixel (i=0, j=1) is at surface (1, 1).
+        assert_eq!(dst[0], 0);
+        assert_eq!(dst[5 + 1], 0x00_00_01_ff);
+        assert_eq!(dst[2 * 5 + 3], 0x00_02_00_ff);
+        assert_eq!(dst[3 * 5 + 4], 0);
+        // A smaller surface clips instead of panicking.
+        let mut small = vec![0u32; 2];
+        blit_xrgb(&rgba, 3, 2, &mut small, 2, 1);
+    }
+
+    #[test]
+    fn window_positions_count_rows_from_the_bottom() {
+        assert_eq!(
+            window_to_pixel(0.0, 0.0, 320, 180, 320, 180),
+            Some((0, 179))
+        );
+        assert_eq!(
+            window_to_pixel(319.9, 179.9, 320, 180, 320, 180),
+            Some((319, 0))
+        );
+        assert_eq!(window_to_pixel(320.0, 0.0, 320, 180, 320, 180), None);
+        // Centred in a larger window: 40 px of border on each side.
+        assert_eq!(
+            window_to_pixel(40.0, 10.0, 320, 180, 400, 200),
+            Some((0, 179))
+        );
+        assert_eq!(window_to_pixel(39.0, 10.0, 320, 180, 400, 200), None);
+    }
+}

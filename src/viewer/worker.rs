@@ -1,0 +1,329 @@
+//! The render thread. The window submits a job per view (camera and size); the worker
+//! runs its passes ([`plan`]) through the library's renderer (on rayon's threads) and
+//! reports each finished pass through a callback, which in the window wakes the event
+//! loop. A new job cancels the running one through its [`RenderControl`], so stale
+//! work stops within a row of pixels; the worker then skips to the newest job.
+
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::Instant;
+
+use glam::Vec3;
+
+use crate::camera::Camera;
+use crate::render::{self, Frame, RenderControl, RenderError, RenderOptions};
+use crate::scene::Scene;
+use crate::trace::fast::FastTracer;
+
+use super::buffer::{to_rgba_top_down, upscale};
+use super::schedule::{plan, Pass};
+
+/// One view to render: the scene (its camera is the view's), at this size.
+pub struct Job {
+    pub generation: u64,
+    pub scene: Arc<Scene>,
+    pub width: u32,
+    pub height: u32,
+    /// The preview's size is 1/`preview_factor` of the view's.
+    pub preview_factor: u32,
+    control: Arc<RenderControl>,
+    submitted: Instant,
+}
+
+/// A finished pass, ready to show.
+#[derive(Clone, Debug)]
+pub struct Shown {
+    pub generation: u64,
+    /// Linear RGB at the full size of the job (a preview is scaled up), row 0 at the
+    /// bottom: what `S` saves.
+    pub frame: Arc<Frame>,
+    /// The same, as top-down RGBA bytes: what the window shows.
+    pub rgba: Arc<Vec<u8>>,
+    /// Samples per pixel so far (0 for the preview).
+    pub samples: u32,
+    /// The target samples per pixel.
+    pub target: u32,
+    pub preview: bool,
+    /// The number of pixels rendered in this pass (the preview's are fewer).
+    pub pass_pixels: u64,
+    /// The last pass: the image is complete.
+    pub done: bool,
+    /// Time this pass took.
+    pub pass_seconds: f64,
+    /// Time since the job was submitted.
+    pub since_submit: f64,
+}
+
+pub enum Report {
+    Frame(Shown),
+    Failed { generation: u64, message: String },
+}
+
+/// The handle the window keeps: submits jobs, cancels stale ones.
+pub struct Worker {
+    jobs: Option<Sender<Job>>,
+    current: Option<Arc<RenderControl>>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Worker {
+    /// Starts the render thread; `sink` receives every report (from that thread).
+    pub fn spawn(sink: impl Fn(Report) + Send + 'static) -> Worker {
+        let (tx, rx) = mpsc::channel::<Job>();
+        let thread = std::thread::Builder::new()
+            .name("whitted-render".into())
+            .spawn(move || serve(rx, sink))
+            .expect("cannot start the render thread");
+        Worker {
+            jobs: Some(tx),
+            current: None,
+            thread: Some(thread),
+        }
+    }
+
+    /// Cancels the running job and queues this one.
+    pub fn submit(
+        &mut self,
+        generation: u64,
+        scene: Arc<Scene>,
+        (width, height): (u32, u32),
+        preview_factor: u32,
+    ) {
+        self.cancel();
+        let control = Arc::new(RenderControl::default());
+        self.current = Some(Arc::clone(&control));
+        let job = Job {
+            generation,
+            scene,
+            width,
+            height,
+            preview_factor,
+            control,
+            submitted: Instant::now(),
+        };
+        if let Some(jobs) = &self.jobs {
+            // The thread only ends when this sender is dropped, so this cannot fail
+            // unless it panicked; then there is nothing better to do than not render.
+            let _ = jobs.send(job);
+        }
+    }
+
+    /// Stops the running job (if any).
+    pub fn cancel(&mut self) {
+        if let Some(control) = self.current.take() {
+            control.cancel();
+        }
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        self.cancel();
+        self.jobs = None;
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+fn serve(rx: Receiver<Job>, sink: impl Fn(Report)) {
+    let mut cache = TracerCache::default();
+    while let Ok(mut job) = rx.recv() {
+        // Only the newest queued view matters.
+        while let Ok(newer) = rx.try_recv() {
+            job = newer;
+        }
+        match run(&job, &mut cache, &sink) {
+            Ok(()) | Err(RenderError::Cancelled) => {}
+            Err(RenderError::Invalid(message)) => sink(Report::Failed {
+                generation: job.generation,
+                message,
+            }),
+        }
+    }
+}
+
+/// The last view's tracer: a new view of the same scene reuses its compiled scene and
+/// rebuilds only the camera's part (see `FastTracer::with_camera`).
+#[derive(Default)]
+pub struct TracerCache {
+    last: Option<(Arc<Scene>, FastTracer)>,
+}
+
+impl TracerCache {
+    fn tracer(
+        &mut self,
+        scene: &Arc<Scene>,
+        opts: &RenderOptions,
+    ) -> Result<&FastTracer, RenderError> {
+        let camera = Camera::for_scene(scene, opts.image.width, opts.image.height)
+            .map_err(|m| RenderError::Invalid(format!("camera: {m}")))?;
+        let depth = opts.image.max_depth;
+        let tracer = match self.last.take() {
+            Some((s, previous)) if Arc::ptr_eq(&s, scene) => previous.with_camera(&camera, depth),
+            _ => FastTracer::new(scene, &camera, depth),
+        };
+        Ok(&self.last.insert((Arc::clone(scene), tracer)).1)
+    }
+}
+
+/// Renders all passes of `job`, reporting each; stops early when cancelled.
+pub fn run(job: &Job, cache: &mut TracerCache, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
+    let scene = job.scene.as_ref();
+    let control = job.control.as_ref();
+    let mut opts = RenderOptions::for_scene(scene);
+    opts.image.width = job.width;
+    opts.image.height = job.height;
+    opts.check()?;
+    let (w, h) = (job.width, job.height);
+    let target = opts.image.spp;
+    let tracer = cache.tracer(&job.scene, &opts)?;
+    let mut sums = vec![Vec3::ZERO; w as usize * h as usize];
+    let passes = plan(w, h, target, job.preview_factor);
+    let last = passes.len() - 1;
+    for (index, pass) in passes.into_iter().enumerate() {
+        if control.is_cancelled() {
+            return Err(RenderError::Cancelled);
+        }
+        let start = Instant::now();
+        let (frame, samples, preview, pass_pixels) = match pass {
+            Pass::Preview {
+                width,
+                height,
+                factor,
+            } => {
+                // The full-size tracer: its camera takes film positions in [0,1]², so
+                // fewer pixels give the same view, and nothing is compiled twice.
+                let mut small = opts.clone();
+                small.image.width = width;
+                small.image.height = height;
+                small.image.spp = 1;
+                let mut preview_sums = vec![Vec3::ZERO; width as usize * height as usize];
+                render::accumulate(tracer, &small, 0..1, &mut preview_sums, control)?;
+                let preview = render::resolve(&preview_sums, 1, width, height);
+                let pixels = u64::from(width) * u64::from(height);
+                (upscale(&preview, factor, w, h), 0, true, pixels)
+            }
+            Pass::Samples(range) => {
+                let end = range.end;
+                let pixels = u64::from(w) * u64::from(h) * range.len() as u64;
+                render::accumulate(tracer, &opts, range, &mut sums, control)?;
+                (render::resolve(&sums, end, w, h), end, false, pixels)
+            }
+        };
+        let rgba = to_rgba_top_down(&frame);
+        sink(Report::Frame(Shown {
+            generation: job.generation,
+            frame: Arc::new(frame),
+            rgba: Arc::new(rgba),
+            samples,
+            target,
+            preview,
+            pass_pixels,
+            done: index == last,
+            pass_seconds: start.elapsed().as_secs_f64(),
+            since_submit: job.submitted.elapsed().as_secs_f64(),
+        }));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{hw3_scene, HW3_DEFAULT_SEED};
+    use std::sync::Mutex;
+    use std::time::Duration;
+
+    fn collect(worker_scene: Scene, w: u32, h: u32) -> Vec<Shown> {
+        let shown = Arc::new(Mutex::new(Vec::new()));
+        let sink = {
+            let shown = Arc::clone(&shown);
+            move |r: Report| match r {
+                Report::Frame(s) => shown.lock().unwrap().push(s),
+                Report::Failed { message, .. } => panic!("render failed: {message}"),
+            }
+        };
+        let job = Job {
+            generation: 7,
+            scene: Arc::new(worker_scene),
+            width: w,
+            height: h,
+            preview_factor: 4,
+            control: Arc::new(RenderControl::default()),
+            submitted: Instant::now(),
+        };
+        run(&job, &mut TracerCache::default(), &sink).unwrap();
+        let v = shown.lock().unwrap().clone();
+        v
+    }
+
+    #[test]
+    fn the_last_pass_equals_a_one_shot_render() {
+        let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+        scene.image.spp = 5;
+        let (w, h) = (192, 108);
+        let shown = collect(scene.clone(), w, h);
+        // Preview, then samples 1, 2, 4, 5.
+        let counts: Vec<u32> = shown.iter().map(|s| s.samples).collect();
+        assert_eq!(counts, vec![0, 1, 2, 4, 5]);
+        assert!(shown[0].preview && !shown[1].preview);
+        assert!(shown.last().unwrap().done && !shown[3].done);
+        let mut opts = RenderOptions::for_scene(&scene);
+        opts.image.width = w;
+        opts.image.height = h;
+        let (expected, _) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+        assert_eq!(*shown.last().unwrap().frame, expected);
+        // The preview is the same view at a quarter of the size, scaled up.
+        let mut small = opts.clone();
+        (small.image.width, small.image.height, small.image.spp) = (w / 4, h / 4, 1);
+        let (preview, _) = render::render(&scene, &small, &RenderControl::default()).unwrap();
+        assert_eq!(*shown[0].frame, upscale(&preview, 4, w, h));
+        // The 1-sample pass is the first sample of the 5-spp pattern.
+        let tracer = render::make_tracer(&scene, &opts).unwrap();
+        let mut sums = vec![Vec3::ZERO; (w * h) as usize];
+        render::accumulate(tracer.as_ref(), &opts, 0..1, &mut sums, &Default::default()).unwrap();
+        assert_eq!(*shown[1].frame, render::resolve(&sums, 1, w, h));
+        assert_eq!(*shown[1].rgba, to_rgba_top_down(&shown[1].frame));
+    }
+
+    #[test]
+    fn a_new_job_cancels_the_old_one() {
+        let (tx, rx) = mpsc::channel();
+        let mut worker = Worker::spawn(move |r| {
+            let _ = tx.send(r);
+        });
+        let mut big = hw3_scene(HW3_DEFAULT_SEED);
+        big.image.spp = 64;
+        worker.submit(1, Arc::new(big), (640, 360), 4);
+        let mut small = hw3_scene(HW3_DEFAULT_SEED);
+        small.image.spp = 1;
+        worker.submit(2, Arc::new(small), (32, 18), 4);
+        // The small job completes; the big one never reaches its last pass.
+        loop {
+            match rx.recv_timeout(Duration::from_secs(60)).expect("a report") {
+                Report::Frame(s) if s.generation == 2 && s.done => {
+                    assert_eq!((s.frame.width, s.frame.height), (32, 18));
+                    break;
+                }
+                Report::Frame(s) => assert!(!(s.generation == 1 && s.done)),
+                Report::Failed { message, .. } => panic!("{message}"),
+            }
+        }
+        drop(worker);
+    }
+
+    #[test]
+    fn bad_sizes_are_reported_not_panicked() {
+        let (tx, rx) = mpsc::channel();
+        let mut worker = Worker::spawn(move |r| {
+            let _ = tx.send(r);
+        });
+        worker.submit(3, Arc::new(hw3_scene(HW3_DEFAULT_SEED)), (0, 10), 4);
+        match rx.recv_timeout(Duration::from_secs(60)).expect("a report") {
+            Report::Failed { generation, .. } => assert_eq!(generation, 3),
+            Report::Frame(_) => panic!("a 0-wide frame rendered"),
+        }
+    }
+}

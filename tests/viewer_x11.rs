@@ -1,0 +1,545 @@
+//! The viewer driven for real: the release binary in an Xvfb server, for both blit
+//! paths. Screenshots (`import -window`) are compared pixel by pixel with what
+//! `whitted render` writes; keys are real key presses (XTEST via `xdotool key` to the
+//! focused window), since winit ignores synthetic events.
+//!
+//! The tests need `Xvfb`, `xdotool` and ImageMagick's `import`; without them they say
+//! so loudly on stderr and pass (CI always has them: see `.ci/run`).
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use image::RgbImage;
+
+const BIN: &str = env!("CARGO_BIN_EXE_whitted");
+const TIMEOUT: Duration = Duration::from_secs(120);
+
+fn have(tool: &str) -> bool {
+    std::env::var_os("PATH")
+        .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(tool).is_file()))
+}
+
+/// Whether the X tools are installed; if not, says loudly that `test` is skipped.
+fn x_tools_or_skip(test: &str) -> bool {
+    let missing: Vec<&str> = ["Xvfb", "xdotool", "import"]
+        .into_iter()
+        .filter(|t| !have(t))
+        .collect();
+    if missing.is_empty() {
+        return true;
+    }
+    eprintln!(
+        "\n*** SKIPPED {test}: {} not installed (apt-get install xvfb xdotool imagemagick); \
+         the viewer was NOT tested ***\n",
+        missing.join(", ")
+    );
+    false
+}
+
+/// Polls `f` until it gives a value or `TIMEOUT` passes.
+fn wait_for<T>(what: &str, mut f: impl FnMut() -> Option<T>) -> T {
+    let start = Instant::now();
+    loop {
+        if let Some(v) = f() {
+            return v;
+        }
+        assert!(start.elapsed() < TIMEOUT, "timed out waiting for {what}");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// An Xvfb server on a free display, killed on drop.
+struct XServer {
+    child: Child,
+    display: String,
+    runtime_dir: tempfile::TempDir,
+    log: tempfile::NamedTempFile,
+}
+
+impl XServer {
+    /// Starts Xvfb on a display number of its own. Not `-displayfd`: servers started
+    /// at the same moment that way race for the same number, and the loser unlinks the
+    /// winner's socket. Here each server of this process gets its own number from a
+    /// range picked by the process id, skipping numbers whose lock file exists.
+    fn start() -> XServer {
+        use std::sync::atomic::{AtomicU32, Ordering};
+        static NEXT: AtomicU32 = AtomicU32::new(0);
+        let base = 200 + (std::process::id() % 500) * 16;
+        for _ in 0..16 {
+            let number = base + NEXT.fetch_add(1, Ordering::Relaxed) % 16;
+            if Path::new(&format!("/tmp/.X{number}-lock")).exists() {
+                continue;
+            }
+            let log = tempfile::NamedTempFile::new().unwrap();
+            let display = format!(":{number}");
+            let child = Command::new("Xvfb")
+                // No reset when the last client leaves: a server resetting refuses
+                // connections for a moment, and the probe below is such a client.
+                .args([
+                    &display,
+                    "-screen",
+                    "0",
+                    "1280x720x24",
+                    "-nolisten",
+                    "tcp",
+                    "-noreset",
+                ])
+                .stdout(Stdio::null())
+                .stderr(Stdio::from(log.reopen().unwrap()))
+                .spawn()
+                .expect("Xvfb starts");
+            let mut server = XServer {
+                child,
+                display,
+                runtime_dir: tempfile::tempdir().unwrap(),
+                log,
+            };
+            if server.wait_ready() {
+                return server;
+            }
+        }
+        panic!("could not start Xvfb on any of 16 display numbers from {base}");
+    }
+
+    /// Waits until clients can connect; false if the server gave up (number taken).
+    fn wait_ready(&mut self) -> bool {
+        let start = Instant::now();
+        while start.elapsed() < TIMEOUT {
+            if let Ok(Some(_)) = self.child.try_wait() {
+                return false;
+            }
+            let probe = self
+                .command("xdotool")
+                .arg("getdisplaygeometry")
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status();
+            if probe.is_ok_and(|s| s.success()) {
+                return true;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        false
+    }
+
+    fn command(&self, program: &str) -> Command {
+        let mut c = Command::new(program);
+        c.env("DISPLAY", &self.display)
+            .env_remove("WAYLAND_DISPLAY")
+            .env("XDG_RUNTIME_DIR", self.runtime_dir.path());
+        c
+    }
+
+    /// Runs an X client to completion.
+    fn run(&self, program: &str, args: &[&str]) -> Output {
+        self.command(program)
+            .args(args)
+            .output()
+            .unwrap_or_else(|e| panic!("{program} runs: {e}"))
+    }
+
+    fn xdotool(&self, args: &[&str]) -> String {
+        let out = self.run("xdotool", args);
+        assert!(
+            out.status.success(),
+            "xdotool {args:?} failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).trim().to_string()
+    }
+
+    fn title(&self, window: &str) -> String {
+        self.xdotool(&["getwindowname", window])
+    }
+
+    /// Waits until the window's title satisfies `ok`; returns it.
+    fn wait_title(&self, viewer: &mut Viewer, window: &str, ok: impl Fn(&str) -> bool) -> String {
+        wait_for("the window title", || {
+            viewer.assert_running();
+            let t = self.title(window);
+            ok(&t).then_some(t)
+        })
+    }
+
+    /// A screenshot of the window.
+    fn screenshot(&self, window: &str, dir: &Path, name: &str) -> RgbImage {
+        let path = dir.join(name);
+        let out = self.run("import", &["-window", window, path.to_str().unwrap()]);
+        assert!(
+            out.status.success(),
+            "import failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        image::open(&path).expect("a screenshot").to_rgb8()
+    }
+
+    /// A real key press to the focused window.
+    fn key(&self, window: &str, key: &str) {
+        self.xdotool(&["windowfocus", "--sync", window]);
+        self.xdotool(&["key", key]);
+    }
+}
+
+impl Drop for XServer {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The viewer process, killed on drop if still running.
+struct Viewer {
+    child: Child,
+    stdout: PathBuf,
+    stderr: PathBuf,
+    /// What Xvfb said, for failures.
+    xlog: String,
+}
+
+impl Viewer {
+    fn stdout(&self) -> String {
+        fs::read_to_string(&self.stdout).unwrap_or_default()
+    }
+
+    fn stderr(&self) -> String {
+        fs::read_to_string(&self.stderr).unwrap_or_default()
+    }
+
+    fn assert_running(&mut self) {
+        if let Ok(Some(status)) = self.child.try_wait() {
+            panic!(
+                "the viewer exited early with {status}; stderr:\n{}\nXvfb: {}",
+                self.stderr(),
+                self.xlog
+            );
+        }
+    }
+
+    fn wait_stdout(&mut self, needle: &str) {
+        wait_for(&format!("`{needle}` on stdout"), || {
+            self.assert_running();
+            self.stdout().contains(needle).then_some(())
+        })
+    }
+}
+
+impl Drop for Viewer {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// The built-in scene at 320×180 written as `small.toml` in `dir`.
+fn small_scene(dir: &Path, spp: u32) -> PathBuf {
+    let mut scene = whitted::scene::hw3_scene(whitted::scene::HW3_DEFAULT_SEED);
+    scene.image.width = 320;
+    scene.image.height = 180;
+    scene.image.spp = spp;
+    let path = dir.join("small.toml");
+    fs::write(&path, whitted::scene::to_toml(&scene)).unwrap();
+    path
+}
+
+/// `whitted render` of the scene, decoded.
+fn headless(dir: &Path, scene: &Path, extra: &[&str], name: &str) -> RgbImage {
+    let out_path = dir.join(name);
+    let out = Command::new(BIN)
+        .arg("render")
+        .arg(scene)
+        .arg("-o")
+        .arg(&out_path)
+        .arg("--quiet")
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "render failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    image::open(&out_path).unwrap().to_rgb8()
+}
+
+/// The number of pixels that differ (images of different sizes differ everywhere).
+fn differing(a: &RgbImage, b: &RgbImage) -> usize {
+    if a.dimensions() != b.dimensions() {
+        return (a.width() * a.height()).max(b.width() * b.height()) as usize;
+    }
+    a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count()
+}
+
+/// Screenshots until one equals `expected` (the last pass may still be on its way to
+/// the screen when the title changes); returns the number of differing pixels of the
+/// last screenshot.
+fn screenshot_matching(x: &XServer, window: &str, dir: &Path, expected: &RgbImage) -> usize {
+    let mut diff = usize::MAX;
+    for attempt in 0..20 {
+        let shot = x.screenshot(window, dir, &format!("shot-{attempt}.png"));
+        diff = differing(&shot, expected);
+        if diff == 0 {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(250));
+    }
+    diff
+}
+
+fn start_viewer(x: &XServer, dir: &Path, scene: &Path, blit: &str) -> (Viewer, String) {
+    start_viewer_with(x, dir, scene, &[("WHITTED_BLIT", blit)])
+}
+
+fn start_viewer_with(
+    x: &XServer,
+    dir: &Path,
+    scene: &Path,
+    env: &[(&str, &str)],
+) -> (Viewer, String) {
+    let stdout = dir.join("viewer.out");
+    let stderr = dir.join("viewer.err");
+    let child = x
+        .command(BIN)
+        .arg("view")
+        .arg(scene)
+        .current_dir(dir)
+        .envs(env.iter().copied())
+        .env("WHITTED_STATS", "1")
+        .stdin(Stdio::null())
+        .stdout(fs::File::create(&stdout).unwrap())
+        .stderr(fs::File::create(&stderr).unwrap())
+        .spawn()
+        .expect("the viewer starts");
+    let xlog = format!(
+        "display {}, log {}: {}",
+        x.display,
+        x.log.path().display(),
+        fs::read_to_string(x.log.path()).unwrap_or_default()
+    );
+    let mut viewer = Viewer {
+        child,
+        stdout,
+        stderr,
+        xlog,
+    };
+    let window = wait_for("the window", || {
+        viewer.assert_running();
+        let out = x.run(
+            "xdotool",
+            &["search", "--onlyvisible", "--name", "^whitted - small - "],
+        );
+        let id = String::from_utf8_lossy(&out.stdout);
+        id.lines().next().map(str::to_string)
+    });
+    (viewer, window)
+}
+
+/// The whole session of SPEC §6 with one blitter.
+fn session(blit: &str) {
+    let test = format!("viewer session with WHITTED_BLIT={blit}");
+    if !x_tools_or_skip(&test) {
+        return;
+    }
+    let x = XServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let scene = small_scene(dir, 1);
+    let expected = headless(dir, &scene, &[], "render.png");
+
+    let (mut viewer, window) = start_viewer(&x, dir, &scene, blit);
+    let title = x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
+    assert!(
+        title.starts_with("whitted - small - 320x180 - 1/1 spp - "),
+        "title: {title}"
+    );
+    // WHITTED_STATS names the blitter that drew the first frame.
+    assert!(
+        viewer
+            .stderr()
+            .contains(&format!("stats: blitter {blit}\n")),
+        "WHITTED_BLIT={blit} was not used: {}",
+        viewer.stderr()
+    );
+
+    // What the window shows equals the headless render, pixel for pixel.
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(
+        diff, 0,
+        "{blit}: {diff} pixels differ from `whitted render`"
+    );
+    let shot = x.screenshot(&window, dir, "shown.png");
+
+    // S saves what is on screen, under new names each time.
+    x.key(&window, "s");
+    viewer.wait_stdout("saved small-001.png and small-001.ppm");
+    for name in ["small-001.png", "small-001.ppm"] {
+        let saved = image::open(dir.join(name)).unwrap().to_rgb8();
+        assert_eq!(
+            differing(&saved, &shot),
+            0,
+            "{name} differs from the screen"
+        );
+    }
+    x.key(&window, "s");
+    viewer.wait_stdout("saved small-002.png and small-002.ppm");
+    let second = image::open(dir.join("small-002.ppm")).unwrap().to_rgb8();
+    assert_eq!(differing(&second, &shot), 0);
+
+    // A click prints the pixel, counted from the bottom, and its ray tree.
+    x.xdotool(&["mousemove", "--sync", "10", "170", "click", "1"]);
+    viewer.wait_stdout("pixel i=10 j=9 (j from the bottom) of 320x180");
+    viewer.wait_stdout("primary  depth 0 sphere 0");
+
+    // A drag orbits (the picture changes); R brings back the scene's camera.
+    x.xdotool(&["mousemove", "--sync", "160", "90", "mousedown", "1"]);
+    for step in 1..=4 {
+        let to = (160 + 15 * step).to_string();
+        x.xdotool(&["mousemove", "--sync", &to, "100"]);
+    }
+    x.xdotool(&["mouseup", "1"]);
+    wait_for("the orbited view", || {
+        viewer.assert_running();
+        let done = x.title(&window).ends_with("- done");
+        let orbited = x.screenshot(&window, dir, "orbited.png");
+        (done && differing(&orbited, &expected) > 1000).then_some(())
+    });
+    x.key(&window, "r");
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(diff, 0, "{blit}: after R, {diff} pixels differ");
+
+    // The arrows and PageUp move the camera; R again brings it back; H lists keys.
+    for key in ["Up", "Left", "Prior"] {
+        x.key(&window, key);
+    }
+    wait_for("the moved view", || {
+        viewer.assert_running();
+        let done = x.title(&window).ends_with("- done");
+        let moved = x.screenshot(&window, dir, "moved.png");
+        (done && differing(&moved, &expected) > 1000).then_some(())
+    });
+    x.key(&window, "r");
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(diff, 0, "{blit}: after moving and R, {diff} pixels differ");
+    x.key(&window, "h");
+    viewer.wait_stdout("PageUp, PageDown");
+
+    // Resizing re-renders at the new size, with the same vertical field of view as a
+    // headless render at that size.
+    x.xdotool(&["windowsize", &window, "240", "200"]);
+    x.wait_title(&mut viewer, &window, |t| {
+        t.contains(" 240x200 ") && t.ends_with("- done")
+    });
+    let resized = headless(
+        dir,
+        &scene,
+        &["--width", "240", "--height", "200"],
+        "resized.png",
+    );
+    let diff = screenshot_matching(&x, &window, dir, &resized);
+    assert_eq!(diff, 0, "{blit}: after resizing, {diff} pixels differ");
+
+    // Esc quits with status 0.
+    x.key(&window, "Escape");
+    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
+    assert!(
+        status.success(),
+        "exit status {status}; stderr:\n{}",
+        viewer.stderr()
+    );
+}
+
+#[test]
+fn session_with_pixels() {
+    session("pixels");
+}
+
+#[test]
+fn session_with_softbuffer() {
+    session("softbuffer");
+}
+
+#[test]
+fn samples_accumulate_to_the_render_at_the_target_spp() {
+    if !x_tools_or_skip("progressive refinement test") {
+        return;
+    }
+    let x = XServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let scene = small_scene(dir, 6);
+    let expected = headless(dir, &scene, &[], "render.png");
+    let (mut viewer, window) = start_viewer(&x, dir, &scene, "softbuffer");
+    let title = x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
+    assert!(title.contains(" 6/6 spp "), "title: {title}");
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(diff, 0, "{diff} pixels differ from the 6-spp render");
+    x.key(&window, "q");
+    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
+    assert!(status.success());
+}
+
+#[test]
+fn without_a_gpu_adapter_it_falls_back_to_softbuffer() {
+    if !x_tools_or_skip("softbuffer fallback test") {
+        return;
+    }
+    let x = XServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let scene = small_scene(dir, 1);
+    let expected = headless(dir, &scene, &[], "render.png");
+    // Vulkan only, and no Vulkan driver: wgpu finds no adapter.
+    let no_gpu = [
+        ("WHITTED_BLIT", ""),
+        ("WGPU_BACKEND", "vulkan"),
+        ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+        ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+    ];
+    let (mut viewer, window) = start_viewer_with(&x, dir, &scene, &no_gpu);
+    x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
+    let stderr = viewer.stderr();
+    assert!(
+        stderr.contains("drawing with softbuffer instead")
+            && stderr.contains("stats: blitter softbuffer\n"),
+        "{stderr}"
+    );
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(diff, 0, "{diff} pixels differ from `whitted render`");
+    x.key(&window, "q");
+    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
+    assert!(status.success());
+}
+
+#[test]
+fn without_a_display_it_says_so_and_exits_1() {
+    let out = Command::new(BIN)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+    assert!(
+        stderr.contains("no display") && stderr.contains("whitted render"),
+        "{stderr}"
+    );
+    // An unreachable display is the same kind of error.
+    let out = Command::new(BIN)
+        .args(["view"])
+        .env("DISPLAY", ":9999")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+    assert!(
+        stderr.contains("cannot open the display") && stderr.contains("whitted render"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains(".rs:"), "no source locations: {stderr}");
+}
