@@ -126,12 +126,19 @@ fn usage_errors_exit_2() {
     ] {
         let out = whitted(args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert!(
-            stderr(&out).starts_with("error: "),
-            "{args:?}: {}",
-            stderr(&out)
-        );
+        // One line, like every other error.
+        let err = stderr(&out);
+        assert!(err.starts_with("error: "), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
     }
+    // The hints stay on that line: a similar option, the possible values.
+    let err = stderr(&whitted(&["render", "--widht", "5"]));
+    assert!(
+        err.contains("'--widht'") && err.contains("'--width'"),
+        "{err}"
+    );
+    let err = stderr(&whitted(&["scene", "hw4"]));
+    assert!(err.contains("hw3"), "{err}");
     // Help and version are not errors.
     for args in [&["--help"][..], &["render", "--help"], &["--version"]] {
         let out = whitted(args);
