@@ -209,7 +209,9 @@ fn assert_pixel(frames: &(Frame, Frame), i: u32, j: u32, expected: DVec3) {
         close(reference, expected, 1e-7),
         "reference {reference} vs {expected}"
     );
-    assert!(close(fast, expected, 2e-6), "fast {fast} vs {expected}");
+    // f32 arithmetic: a few rounding errors of values near 1, far below one 8-bit
+    // level (1/255 = 3.9e-3).
+    assert!(close(fast, expected, 1e-5), "fast {fast} vs {expected}");
 }
 
 /// The default sky for a unit direction with vertical component `y`.
