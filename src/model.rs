@@ -63,8 +63,10 @@ pub trait Vector:
     fn y(self) -> Self::R;
     fn splat(x: Self::R) -> Self;
     fn from_dvec3(v: DVec3) -> Self;
+    /// One division and three products (three divisions would each wait on the square
+    /// root and on the divider).
     fn normalize(self) -> Self {
-        self / self.dot(self).sqrt()
+        self * (Self::R::ONE / self.dot(self).sqrt())
     }
 }
 

@@ -210,7 +210,7 @@ impl Spheres {
         // The direction renormalised in `f64`: the exact tests assume `d·d = 1`, which
         // an `f32`-normalised direction misses by up to ~1e-7. Done here, for the few
         // spheres that pass the quick test, not for every ray.
-        let (o, d, t_min) = (ray.o64, renormalize(ray.d32.as_dvec3()), ray.t_min);
+        let (o, d, t_min) = (ray.o64, ray.d32.as_dvec3().normalize(), ray.t_min);
         let (c, r) = (self.center[k], self.radius[k]);
         let own = ray
             .from
@@ -254,7 +254,9 @@ impl Spheres {
         if best.k == usize::MAX {
             return None;
         }
-        let normal = renormalize(best.normal);
+        // (l ∓ √disc·d)/r is a unit vector up to rounding (|l|² + disc = r², l ⊥ d):
+        // no need to normalise again.
+        let normal = best.normal;
         Some(Hit {
             sphere: best.k as u32,
             point: self.center[best.k] + normal * self.radius[best.k],
@@ -355,20 +357,6 @@ impl Best {
         entering: false,
         normal: DVec3::ZERO,
     };
-}
-
-/// A vector within ~1e-6 of unit length scaled to unit length in `f64` without a square
-/// root or a division: with `δ = v·v − 1`, `1/√(1+δ) = 1 − δ/2 + 3δ²/8 − …`, and the
-/// terms left out are below 1e-18. (Directions normalised in `f32`, and normals built
-/// from the roots, are that close.) Anything farther is normalised the usual way.
-#[inline(always)]
-fn renormalize(v: DVec3) -> DVec3 {
-    let delta = v.dot(v) - 1.0;
-    if delta.abs() < 1e-6 {
-        v * (1.0 - delta * (0.5 - 0.375 * delta))
-    } else {
-        v.normalize()
-    }
 }
 
 /// `t` as an `f32` no smaller than it.

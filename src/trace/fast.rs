@@ -169,7 +169,7 @@ impl FastTracer {
                 // From the f64 point, which lies on the sphere.
                 let to_light = light.position - hit.point;
                 let dist = to_light.length();
-                let l = (to_light / dist).as_vec3();
+                let l = (to_light * (1.0 / dist)).as_vec3();
                 let cos = nf.dot(l);
                 if cos > 0.0 {
                     counts.shadow += 1;

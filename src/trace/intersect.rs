@@ -20,13 +20,13 @@ impl<V: Vector> Roots<V> {
     /// Outward unit normal at the near root: `(l − half_chord·d)/r`, no cancellation.
     #[inline]
     pub fn normal_near(&self, d: V, radius: V::R) -> V {
-        (self.closest - d * self.half_chord) / radius
+        (self.closest - d * self.half_chord) * (V::R::ONE / radius)
     }
 
     /// Outward unit normal at the far root.
     #[inline]
     pub fn normal_far(&self, d: V, radius: V::R) -> V {
-        (self.closest + d * self.half_chord) / radius
+        (self.closest + d * self.half_chord) * (V::R::ONE / radius)
     }
 }
 
