@@ -10,9 +10,11 @@
 #![forbid(unsafe_code)]
 
 pub mod accel;
+pub mod bench;
 pub mod camera;
 pub mod image_io;
 pub mod model;
+pub mod quality;
 pub mod render;
 pub mod sampling;
 pub mod scene;

@@ -10,7 +10,9 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, Context};
 use clap::{Args, Parser, Subcommand};
 
+use whitted::bench::{self, BenchOptions};
 use whitted::image_io::{self, Format};
+use whitted::quality::Preset;
 use whitted::render::{self, Region, RenderControl, RenderOptions, Renderer};
 use whitted::scene::{self, Scene};
 
@@ -31,6 +33,9 @@ enum Command {
     View {
         /// A scene file (TOML).
         scene: Option<PathBuf>,
+        /// Quality preset: draft, default, high or reference (docs/quality.md).
+        #[arg(long, value_name = "PRESET")]
+        quality: Option<Preset>,
     },
     /// Render without a window and write image files.
     Render(RenderArgs),
@@ -46,6 +51,9 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
         threads: Option<u32>,
     },
+    /// Measure run time against error over a grid of quality settings on several
+    /// scenes; writes bench.csv, bench.md and bench.svg (docs/quality.md).
+    Bench(BenchArgs),
     /// Print a built-in scene as a scene file.
     Scene {
         /// The built-in scene: only "hw3".
@@ -92,9 +100,53 @@ struct RenderArgs {
     /// Use the slow f64 reference renderer.
     #[arg(long)]
     reference: bool,
+    /// Quality preset: draft, default, high or reference (docs/quality.md); the
+    /// other options override its settings.
+    #[arg(long, value_name = "PRESET")]
+    quality: Option<Preset>,
     /// No progress bar and no closing line.
     #[arg(short, long)]
     quiet: bool,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// Folder for the outputs (and a cache of the slow reference images).
+    #[arg(long, value_name = "DIR", default_value = "bench-out")]
+    out: PathBuf,
+    /// Image size of every render.
+    #[arg(long, value_name = "WxH", default_value = "320x180", value_parser = bench::parse_size)]
+    size: (u32, u32),
+    /// Timed runs per setting, at least (the median is reported; settings that take
+    /// milliseconds get up to 10 times as many).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    runs: u32,
+    /// A tiny grid on small scenes, for a quick check.
+    #[arg(long)]
+    tiny: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    /// No progress bar and no summary.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn bench_command(args: BenchArgs) -> anyhow::Result<()> {
+    let opts = BenchOptions {
+        out: args.out,
+        width: args.size.0,
+        height: args.size.1,
+        runs: args.runs as usize,
+        tiny: args.tiny,
+        threads: args.threads.map(|t| t as usize),
+        progress: !args.quiet && std::io::stderr().is_terminal(),
+    };
+    let rows = bench::run(&opts)?;
+    if !args.quiet {
+        eprint!("{}", bench::summary(&rows, &opts.out));
+    }
+    Ok(())
 }
 
 fn parse_region(text: &str) -> Result<Region, String> {
@@ -143,8 +195,9 @@ fn main() -> ExitCode {
         }
     };
     let result = match cli.command {
-        None => view(None),
-        Some(Command::View { scene }) => view(scene.as_deref()),
+        None => view(None, None),
+        Some(Command::View { scene, quality }) => view(scene.as_deref(), quality),
+        Some(Command::Bench(args)) => bench_command(args),
         Some(Command::Render(args)) => render_command(args),
         Some(Command::Time {
             scene,
@@ -191,8 +244,14 @@ fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
     }
 }
 
-fn view(path: Option<&Path>) -> anyhow::Result<()> {
-    let scene = load_scene(path)?;
+fn view(path: Option<&Path>, quality: Option<Preset>) -> anyhow::Result<()> {
+    let mut scene = load_scene(path)?;
+    if let Some(preset) = quality {
+        // As if the scene file named it: the viewer's RenderOptions::for_scene applies it.
+        scene.image.quality = Some(preset);
+        scene.image.spp = preset.quality().spp;
+        scene.image.max_depth = preset.quality().max_depth;
+    }
     whitted::viewer::run(scene)
 }
 
@@ -234,6 +293,9 @@ fn render_command(args: RenderArgs) -> anyhow::Result<()> {
 
     let scene = load_scene(args.scene.as_deref())?;
     let mut opts = RenderOptions::for_scene(&scene);
+    if let Some(preset) = args.quality {
+        preset.quality().apply(&mut opts);
+    }
     let image = &mut opts.image;
     image.width = args.width.unwrap_or(image.width);
     image.height = args.height.unwrap_or(image.height);

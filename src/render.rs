@@ -4,12 +4,14 @@
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::camera::Camera;
+use crate::quality::{Adaptive, Quality};
 use crate::sampling::sample_offset;
 use crate::scene::{ImageSettings, Scene};
 use crate::trace::fast::FastTracer;
@@ -43,17 +45,38 @@ pub struct RenderOptions {
     /// Worker threads (`None`: all cores).
     pub threads: Option<usize>,
     pub renderer: Renderer,
+    /// Adaptive anti-aliasing (`None`: every pixel gets all `image.spp` samples).
+    pub adaptive: Option<Adaptive>,
+    /// Contribution cutoff ε of the fast tracer (0: exact).
+    pub cutoff: f32,
 }
 
 impl RenderOptions {
     /// The scene's own settings, all of the image, all cores, the fast tracer.
+    /// With a quality preset in the scene file, its knobs (its spp and depth are
+    /// already in the scene's image settings).
     pub fn for_scene(scene: &Scene) -> Self {
-        RenderOptions {
+        let mut opts = RenderOptions {
             image: scene.image,
             region: None,
             threads: None,
             renderer: Renderer::Fast,
+            adaptive: None,
+            cutoff: 0.0,
+        };
+        if let Some(preset) = scene.image.quality {
+            let q = preset.quality();
+            opts.adaptive = q.adaptive;
+            opts.cutoff = q.cutoff;
+            opts.renderer = q.precision;
         }
+        opts
+    }
+
+    /// These options with the settings of `quality` (see [`Quality::apply`]).
+    pub fn with_quality(mut self, quality: &Quality) -> Self {
+        quality.apply(&mut self);
+        self
     }
 
     /// The rectangle to render (the whole image without a region).
@@ -81,6 +104,7 @@ impl RenderOptions {
                 )));
             }
         }
+        Quality::of(self).check().map_err(RenderError::Invalid)?;
         if self.threads == Some(0) {
             return Err(RenderError::Invalid("threads must be at least 1".into()));
         }
@@ -165,13 +189,97 @@ pub fn make_tracer<'a>(
         .map_err(|m| RenderError::Invalid(format!("camera: {m}")))?;
     let depth = opts.image.max_depth;
     Ok(match opts.renderer {
-        Renderer::Fast => Box::new(FastTracer::new(scene, &camera, depth)),
+        Renderer::Fast => Box::new(FastTracer::new(scene, &camera, depth).with_cutoff(opts.cutoff)),
         Renderer::Reference => Box::new(ReferenceTracer::new(scene, camera, depth)),
     })
 }
 
 /// Rows per unit of parallel work.
 const BAND_ROWS: usize = 8;
+
+/// Runs `pixel(i, j, state, counts)` for every pixel of `area` (image pixels, `j` from
+/// the bottom) on the thread pool of `opts`. `states` holds `per_pixel` items for each
+/// pixel of the area, row 0 at the bottom of the area. Progress counts `samples` per
+/// pixel.
+fn for_each_pixel<T, F>(
+    opts: &RenderOptions,
+    area: Region,
+    states: &mut [T],
+    per_pixel: usize,
+    samples: u64,
+    control: &RenderControl,
+    pixel: F,
+) -> Result<RayCounts, RenderError>
+where
+    T: Send,
+    F: Fn(u32, u32, &mut [T], &mut RayCounts) + Sync,
+{
+    let aw = area.width as usize;
+    assert_eq!(
+        states.len(),
+        aw * area.height as usize * per_pixel,
+        "states must cover the area"
+    );
+    // The area's bottom row, counted from the image's bottom.
+    let j0 = opts.image.height - (area.y + area.height);
+    let row_len = aw * per_pixel;
+    let mut work = || {
+        states
+            .par_chunks_mut(row_len * BAND_ROWS)
+            .enumerate()
+            .map(|(band, rows)| {
+                let mut counts = RayCounts::default();
+                for (r, row) in rows.chunks_mut(row_len).enumerate() {
+                    if control.is_cancelled() {
+                        return Err(RenderError::Cancelled);
+                    }
+                    let j = j0 + (band * BAND_ROWS + r) as u32;
+                    for (a, state) in row.chunks_mut(per_pixel).enumerate() {
+                        pixel(area.x + a as u32, j, state, &mut counts);
+                    }
+                    control
+                        .pixels_done
+                        .fetch_add(aw as u64 * samples, Ordering::Relaxed);
+                }
+                Ok(counts)
+            })
+            .try_reduce(RayCounts::default, |mut a, b| {
+                a.add(&b);
+                Ok(a)
+            })
+    };
+    match opts.threads {
+        None => work(),
+        Some(n) => thread_pool(n)?.install(work),
+    }
+}
+
+/// A pool of `n` worker threads, started once per process and reused: starting threads
+/// for every render (every frame of the viewer) would cost more than small renders.
+fn thread_pool(n: usize) -> Result<Arc<rayon::ThreadPool>, RenderError> {
+    static POOLS: Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
+    let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, pool)) = pools.iter().find(|(size, _)| *size == n) {
+        return Ok(Arc::clone(pool));
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map_err(|e| RenderError::Invalid(format!("cannot start {n} threads: {e}")))?;
+    let pool = Arc::new(pool);
+    pools.push((n, Arc::clone(&pool)));
+    Ok(pool)
+}
+
+/// The film position of sample `k` of pixel `(i, j)`.
+#[inline]
+fn film(opts: &RenderOptions, i: u32, j: u32, k: u32) -> (f32, f32) {
+    let (sx, sy) = sample_offset(i, j, k, opts.image.spp, opts.image.seed);
+    (
+        (i as f32 + sx) / opts.image.width as f32,
+        (j as f32 + sy) / opts.image.height as f32,
+    )
+}
 
 /// Adds samples `samples` of every pixel of the area into `sums` (area-sized, row 0 at
 /// the bottom of the area), in sample order, so that any split into passes sums the
@@ -183,80 +291,57 @@ pub fn accumulate(
     sums: &mut [Vec3],
     control: &RenderControl,
 ) -> Result<RayCounts, RenderError> {
-    let area = opts.area();
-    let (w, h) = (opts.image.width, opts.image.height);
-    let aw = area.width as usize;
-    assert_eq!(
-        sums.len(),
-        aw * area.height as usize,
-        "sums must cover the area"
-    );
-    // The area's bottom row, counted from the image's bottom.
-    let j0 = h - (area.y + area.height);
-    let (wf, hf) = (w as f32, h as f32);
-    let spp = opts.image.spp;
-    let seed = opts.image.seed;
-
-    let mut work = || {
-        sums.par_chunks_mut(aw * BAND_ROWS)
-            .enumerate()
-            .map(|(band, rows)| {
-                let mut counts = RayCounts::default();
-                for (r, row) in rows.chunks_mut(aw).enumerate() {
-                    if control.is_cancelled() {
-                        return Err(RenderError::Cancelled);
-                    }
-                    let j = j0 + (band * BAND_ROWS + r) as u32;
-                    for (a, sum) in row.iter_mut().enumerate() {
-                        let i = area.x + a as u32;
-                        for k in samples.clone() {
-                            let (sx, sy) = sample_offset(i, j, k, spp, seed);
-                            let s = (i as f32 + sx) / wf;
-                            let t = (j as f32 + sy) / hf;
-                            *sum += tracer.sample(s, t, &mut counts);
-                        }
-                    }
-                    control
-                        .pixels_done
-                        .fetch_add(aw as u64 * samples.len() as u64, Ordering::Relaxed);
-                }
-                Ok(counts)
-            })
-            .try_reduce(RayCounts::default, |mut a, b| {
-                a.add(&b);
-                Ok(a)
-            })
-    };
-    match opts.threads {
-        None => work(),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| RenderError::Invalid(format!("cannot start {n} threads: {e}")))?
-            .install(work),
-    }
+    let n = samples.len() as u64;
+    for_each_pixel(
+        opts,
+        opts.area(),
+        sums,
+        1,
+        n,
+        control,
+        |i, j, sum, counts| {
+            for k in samples.clone() {
+                let (s, t) = film(opts, i, j, k);
+                sum[0] += tracer.sample(s, t, counts);
+            }
+        },
+    )
 }
 
 /// Divides sums of `samples` samples into pixel values; anything non-finite becomes 0
 /// so that no NaN or infinity can reach a file or the window.
 pub fn resolve(sums: &[Vec3], samples: u32, width: u32, height: u32) -> Frame {
-    let n = samples.max(1) as f32;
-    let pixels = sums
-        .iter()
-        .map(|&s| {
-            let c = s / n;
-            if c.is_finite() {
-                c
-            } else {
-                Vec3::ZERO
-            }
-        })
-        .collect();
+    let pixels = sums.iter().map(|&s| pixel_value(s, samples)).collect();
     Frame {
         width,
         height,
         pixels,
     }
+}
+
+/// A sum of `samples` samples as a finite pixel value.
+#[inline]
+fn pixel_value(sum: Vec3, samples: u32) -> Vec3 {
+    let c = sum / samples.max(1) as f32;
+    if c.is_finite() {
+        c
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// A render with what its quality settings cost in accuracy and saved in work.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rendered {
+    pub frame: Frame,
+    /// For each pixel (same layout as the frame), a bound of the error the contribution
+    /// cutoff caused: `|exact − value| ≤ bound` in every colour component, before
+    /// clamping and rounding. All zero without a cutoff.
+    pub cutoff_bound: Vec<f32>,
+    /// Pixels that got more than the first pass of adaptive anti-aliasing (all of them
+    /// without it).
+    pub refined: u64,
+    pub stats: RenderStats,
 }
 
 /// Renders the area of `opts` with all its samples.
@@ -265,18 +350,221 @@ pub fn render(
     opts: &RenderOptions,
     control: &RenderControl,
 ) -> Result<(Frame, RenderStats), RenderError> {
+    let r = render_bounded(scene, opts, control)?;
+    Ok((r.frame, r.stats))
+}
+
+/// Renders the area of `opts` and reports the cutoff's error bound per pixel and how
+/// many pixels adaptive anti-aliasing refined.
+pub fn render_bounded(
+    scene: &Scene,
+    opts: &RenderOptions,
+    control: &RenderControl,
+) -> Result<Rendered, RenderError> {
     opts.check()?;
     let start = Instant::now();
     let tracer = make_tracer(scene, opts)?;
     let build_seconds = start.elapsed().as_secs_f64();
     let area = opts.area();
-    let mut sums = vec![Vec3::ZERO; area.width as usize * area.height as usize];
-    let rays = accumulate(tracer.as_ref(), opts, 0..opts.image.spp, &mut sums, control)?;
-    let frame = resolve(&sums, opts.image.spp, area.width, area.height);
-    let stats = RenderStats {
-        rays,
-        seconds: start.elapsed().as_secs_f64(),
-        build_seconds,
+    let spp = opts.image.spp;
+    let (frame, cutoff_bound, refined, rays) = match opts.adaptive {
+        Some(a) if a.first < spp => adaptive(tracer.as_ref(), opts, a, control)?,
+        _ => {
+            let mut acc = vec![(Vec3::ZERO, 0.0f32); area.width as usize * area.height as usize];
+            let rays = for_each_pixel(
+                opts,
+                area,
+                &mut acc,
+                1,
+                u64::from(spp),
+                control,
+                |i, j, p, counts| {
+                    let (sum, bound) = &mut p[0];
+                    for k in 0..spp {
+                        let (s, t) = film(opts, i, j, k);
+                        let (c, b) = tracer.sample_bounded(s, t, counts);
+                        *sum += c;
+                        *bound += b;
+                    }
+                },
+            )?;
+            let frame = Frame {
+                width: area.width,
+                height: area.height,
+                pixels: acc.iter().map(|p| pixel_value(p.0, spp)).collect(),
+            };
+            let bounds = acc.iter().map(|p| p.1 / spp as f32).collect();
+            (frame, bounds, acc.len() as u64, rays)
+        }
     };
-    Ok((frame, stats))
+    Ok(Rendered {
+        frame,
+        cutoff_bound,
+        refined,
+        stats: RenderStats {
+            rays,
+            seconds: start.elapsed().as_secs_f64(),
+            build_seconds,
+        },
+    })
+}
+
+/// The sample indices of the first adaptive pass: `first` of the `spp` stratified
+/// samples, chosen to spread over the pixel (a plain prefix 0..first would all sit in
+/// the bottom row of strata). Sorted, so that sums keep sample order.
+pub fn first_pass_samples(spp: u32, first: u32, seed: u64) -> Vec<u32> {
+    if first >= spp {
+        return (0..spp).collect();
+    }
+    // Targets on a g×g grid; for each, the nearest unused stratum (the strata are the
+    // same in every pixel, only the jitter differs, so pixel (0, 0) stands for all).
+    let g = (first as f32).sqrt().ceil() as u32;
+    let offsets: Vec<(f32, f32)> = (0..spp)
+        .map(|k| sample_offset(0, 0, k, spp, seed))
+        .collect();
+    let mut chosen: Vec<u32> = Vec::with_capacity(first as usize);
+    for m in 0..first {
+        let tx = ((m % g) as f32 + 0.5) / g as f32;
+        let ty = ((m / g) as f32 + 0.5) / g as f32;
+        let best = (0..spp)
+            .filter(|k| !chosen.contains(k))
+            .min_by(|&a, &b| {
+                let d = |k: u32| {
+                    let (x, y) = offsets[k as usize];
+                    (x - tx).powi(2) + (y - ty).powi(2)
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .expect("fewer chosen than spp");
+        chosen.push(best);
+    }
+    chosen.sort_unstable();
+    chosen
+}
+
+/// Adaptive anti-aliasing: a first pass of a few spread samples per pixel, then the
+/// remaining samples only where the pixel or its 4-neighbours disagree. A refined pixel
+/// sums all its `spp` samples in sample order (the stored first ones in their places),
+/// exactly as a full render does, so threshold 0 is identical to full anti-aliasing.
+#[allow(clippy::type_complexity)]
+fn adaptive(
+    tracer: &dyn SampleTracer,
+    opts: &RenderOptions,
+    a: Adaptive,
+    control: &RenderControl,
+) -> Result<(Frame, Vec<f32>, u64, RayCounts), RenderError> {
+    let spp = opts.image.spp;
+    let area = opts.area();
+    let first = first_pass_samples(spp, a.first, opts.image.seed);
+    let nf = first.len();
+
+    // The first pass covers the area and a one-pixel margin inside the image, so a
+    // region's edge pixels see the same neighbours as in the whole image.
+    let (w, h) = (opts.image.width, opts.image.height);
+    let x0 = area.x.saturating_sub(1);
+    let y0 = area.y.saturating_sub(1);
+    let x1 = (area.x + area.width + 1).min(w);
+    let y1 = (area.y + area.height + 1).min(h);
+    let outer = Region {
+        x: x0,
+        y: y0,
+        width: x1 - x0,
+        height: y1 - y0,
+    };
+    // Per pixel: the first samples' colours and their cutoff bounds.
+    let mut firsts = vec![(Vec3::ZERO, 0.0f32); outer.width as usize * outer.height as usize * nf];
+    let mut rays = for_each_pixel(
+        opts,
+        outer,
+        &mut firsts,
+        nf,
+        nf as u64,
+        control,
+        |i, j, p, counts| {
+            for (slot, &k) in p.iter_mut().zip(&first) {
+                let (s, t) = film(opts, i, j, k);
+                *slot = tracer.sample_bounded(s, t, counts);
+            }
+        },
+    )?;
+
+    // What the first pass shows, clamped as it will be displayed.
+    let ow = outer.width as usize;
+    let shown = |c: Vec3| c.clamp(Vec3::ZERO, Vec3::ONE);
+    let means: Vec<Vec3> = firsts
+        .chunks(nf)
+        .map(|p| shown(p.iter().fold(Vec3::ZERO, |s, q| s + q.0) / nf as f32))
+        .collect();
+    let spread = |p: &[(Vec3, f32)]| {
+        let lo = p
+            .iter()
+            .fold(Vec3::splat(f32::INFINITY), |m, q| m.min(shown(q.0)));
+        let hi = p
+            .iter()
+            .fold(Vec3::splat(f32::NEG_INFINITY), |m, q| m.max(shown(q.0)));
+        (hi - lo).max_element()
+    };
+    // Outer-grid coordinates, row 0 at the bottom: the area starts at (dx, dy).
+    let dx = (area.x - x0) as usize;
+    let dy = (y1 - (area.y + area.height)) as usize;
+    let oh = outer.height as usize;
+    let mut refine = vec![false; area.width as usize * area.height as usize];
+    for (n, flag) in refine.iter_mut().enumerate() {
+        let (ax, ay) = (n % area.width as usize, n / area.width as usize);
+        let (ox, oy) = (ax + dx, ay + dy);
+        let o = oy * ow + ox;
+        let m = means[o];
+        // Refine unless everything is surely below the threshold (so threshold 0, or
+        // a NaN anywhere, refines).
+        let reaches = |x: f32| x.partial_cmp(&a.threshold) != Some(std::cmp::Ordering::Less);
+        let differs = |q: usize| reaches((means[q] - m).abs().max_element());
+        *flag = reaches(spread(&firsts[o * nf..(o + 1) * nf]))
+            || (ox > 0 && differs(o - 1))
+            || (ox + 1 < ow && differs(o + 1))
+            || (oy > 0 && differs(o - ow))
+            || (oy + 1 < oh && differs(o + ow));
+    }
+
+    // Second pass: value and bound of each pixel of the area.
+    let mut out: Vec<(Vec3, f32)> = refine.iter().map(|_| (Vec3::ZERO, 0.0)).collect();
+    let rest = u64::from(spp) - nf as u64;
+    let more = for_each_pixel(opts, area, &mut out, 1, rest, control, |i, j, p, counts| {
+        let (ax, ay) = (
+            (i - area.x) as usize,
+            (j - (h - area.y - area.height)) as usize,
+        );
+        let o = (ay + dy) * ow + ax + dx;
+        let stored = &firsts[o * nf..(o + 1) * nf];
+        let mut sum = Vec3::ZERO;
+        let mut bound = 0.0f32;
+        if refine[ay * area.width as usize + ax] {
+            let mut next = 0;
+            for k in 0..spp {
+                let (c, b) = if next < nf && first[next] == k {
+                    next += 1;
+                    stored[next - 1]
+                } else {
+                    let (s, t) = film(opts, i, j, k);
+                    tracer.sample_bounded(s, t, counts)
+                };
+                sum += c;
+                bound += b;
+            }
+            p[0] = (pixel_value(sum, spp), bound / spp as f32);
+        } else {
+            for &(c, b) in stored {
+                sum += c;
+                bound += b;
+            }
+            p[0] = (pixel_value(sum, nf as u32), bound / nf as f32);
+        }
+    })?;
+    rays.add(&more);
+    let refined = refine.iter().filter(|&&r| r).count() as u64;
+    let frame = Frame {
+        width: area.width,
+        height: area.height,
+        pixels: out.iter().map(|p| p.0).collect(),
+    };
+    Ok((frame, out.iter().map(|p| p.1).collect(), refined, rays))
 }

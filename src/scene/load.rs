@@ -115,6 +115,7 @@ struct FileImage {
     max_depth: Option<Int>,
     spp: Option<Int>,
     seed: Option<Int>,
+    quality: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -426,6 +427,16 @@ fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
     let mut image = ImageSettings::default();
     if let Some(spanned) = &file.image {
         let img = spanned.get_ref();
+        // A quality preset first: the file's own spp and max_depth override its values.
+        if let Some(q) = &img.quality {
+            let preset: crate::quality::Preset = q
+                .get_ref()
+                .parse()
+                .map_err(|m: String| at.at(q.span(), format!("image.quality: {m}")))?;
+            image.spp = preset.quality().spp;
+            image.max_depth = preset.quality().max_depth;
+            image.quality = Some(preset);
+        }
         let dims = [
             (
                 &img.width,

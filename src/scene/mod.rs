@@ -146,6 +146,10 @@ pub struct ImageSettings {
     pub max_depth: u32,
     pub spp: u32,
     pub seed: u64,
+    /// The quality preset the file names (`quality = "draft"`). Its `spp` and
+    /// `max_depth` are already in the fields above (unless the file gave those too);
+    /// its other knobs apply through `RenderOptions::for_scene`.
+    pub quality: Option<crate::quality::Preset>,
 }
 
 impl Default for ImageSettings {
@@ -156,6 +160,7 @@ impl Default for ImageSettings {
             max_depth: 5,
             spp: 1,
             seed: 0,
+            quality: None,
         }
     }
 }

@@ -38,6 +38,8 @@ struct OutImage {
     max_depth: u32,
     spp: u32,
     seed: u64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    quality: Option<&'static str>,
 }
 
 #[derive(Serialize)]
@@ -95,6 +97,7 @@ pub fn to_toml(scene: &Scene) -> String {
             max_depth: scene.image.max_depth,
             spp: scene.image.spp,
             seed: scene.image.seed,
+            quality: scene.image.quality.map(|q| q.name()),
         },
         sky: OutSky {
             down: scene.sky.down.to_array(),

@@ -12,9 +12,10 @@ use std::time::Instant;
 use glam::Vec3;
 
 use crate::camera::Camera;
-use crate::render::{self, Frame, RenderControl, RenderError, RenderOptions};
+use crate::render::{self, Frame, RenderControl, RenderError, RenderOptions, Renderer};
 use crate::scene::Scene;
 use crate::trace::fast::FastTracer;
+use crate::trace::SampleTracer;
 
 use super::buffer::{to_rgba_top_down, upscale};
 use super::schedule::{plan, Pass};
@@ -163,7 +164,8 @@ impl TracerCache {
         let tracer = match self.last.take() {
             Some((s, previous)) if Arc::ptr_eq(&s, scene) => previous.with_camera(&camera, depth),
             _ => FastTracer::new(scene, &camera, depth),
-        };
+        }
+        .with_cutoff(opts.cutoff);
         Ok(&self.last.insert((Arc::clone(scene), tracer)).1)
     }
 }
@@ -178,7 +180,16 @@ pub fn run(job: &Job, cache: &mut TracerCache, sink: &dyn Fn(Report)) -> Result<
     opts.check()?;
     let (w, h) = (job.width, job.height);
     let target = opts.image.spp;
-    let tracer = cache.tracer(&job.scene, &opts)?;
+    // The fast tracer comes from the cache; the f64 reference (a `reference` quality)
+    // is built for each view.
+    let reference;
+    let tracer: &dyn SampleTracer = match opts.renderer {
+        Renderer::Fast => cache.tracer(&job.scene, &opts)?,
+        Renderer::Reference => {
+            reference = render::make_tracer(scene, &opts)?;
+            reference.as_ref()
+        }
+    };
     let mut sums = vec![Vec3::ZERO; w as usize * h as usize];
     let passes = plan(w, h, target, job.preview_factor);
     let last = passes.len() - 1;

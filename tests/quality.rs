@@ -1,0 +1,335 @@
+//! Quality settings: the contribution cutoff's error bound, adaptive anti-aliasing and
+//! the presets, each checked against an independent render (no cutoff, full
+//! anti-aliasing, the f64 reference).
+
+use glam::{DVec3, Vec3};
+use proptest::prelude::*;
+
+use whitted::quality::{Adaptive, Preset, Quality};
+use whitted::render::{
+    accumulate, first_pass_samples, make_tracer, render, render_bounded, resolve, Region,
+    RenderControl, RenderOptions, Renderer,
+};
+use whitted::sampling::sample_offset;
+use whitted::scene::{hw3_scene, Light, Scene, Sphere};
+
+fn hw3_opts(width: u32, height: u32, spp: u32) -> (Scene, RenderOptions) {
+    let scene = hw3_scene(2020);
+    let mut opts = RenderOptions::for_scene(&scene);
+    opts.image.width = width;
+    opts.image.height = height;
+    opts.image.spp = spp;
+    (scene, opts)
+}
+
+/// A random small scene: spheres in front of the camera with any weights, 0–2 lights.
+fn small_scene() -> impl Strategy<Value = Scene> {
+    let sphere = (
+        (-2.0f64..2.0, -1.5f64..1.5, -5.0f64..-1.5),
+        0.1f64..1.2,
+        (0.0f64..1.0, 0.0f64..1.0, 0.0f64..1.0),
+        prop_oneof![Just(0.0), Just(1.0), 0.0f64..1.0],
+        prop_oneof![Just(0.0), Just(1.0), 0.0f64..1.0],
+        1.0f64..2.5,
+    )
+        .prop_map(
+            |((x, y, z), r, (cr, cg, cb), reflect, transmit, ior)| Sphere {
+                color: DVec3::new(cr, cg, cb),
+                reflect,
+                transmit,
+                ior,
+                ..Sphere::new(DVec3::new(x, y, z), r)
+            },
+        );
+    let light =
+        ((-10.0f64..10.0, 0.0f64..10.0, -5.0f64..5.0), 0.0f64..1.0).prop_map(|((x, y, z), i)| {
+            Light {
+                position: DVec3::new(x, y, z),
+                intensity: DVec3::splat(i),
+            }
+        });
+    (
+        prop::collection::vec(sphere, 1..7),
+        prop::collection::vec(light, 0..3),
+        any::<bool>(),
+    )
+        .prop_map(|(mut spheres, lights, ground)| {
+            if ground {
+                spheres.push(Sphere::new(DVec3::new(0.0, -100.5, -2.0), 100.0));
+            }
+            // Start from the built-in scene so that new scene fields keep defaults.
+            let mut scene = hw3_scene(2020);
+            scene.spheres = spheres;
+            scene.lights = lights;
+            scene
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// The per-pixel bound the cutoff reports is never below the true error against
+    /// the same render without a cutoff.
+    #[test]
+    fn cutoff_bound_covers_the_true_error(
+        scene in small_scene(),
+        eps in prop_oneof![Just(1e-3f32), 0.0f32..0.6],
+        depth in 1u32..7,
+        spp in 1u32..3,
+    ) {
+        let mut opts = RenderOptions::for_scene(&scene);
+        opts.image.width = 12;
+        opts.image.height = 8;
+        opts.image.max_depth = depth;
+        opts.image.spp = spp;
+        let exact = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+        prop_assert!(exact.cutoff_bound.iter().all(|&b| b == 0.0));
+        opts.cutoff = eps;
+        let cut = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+        for ((a, b), bound) in cut.frame.pixels.iter().zip(&exact.frame.pixels).zip(&cut.cutoff_bound) {
+            let err = (*a - *b).abs().max_element();
+            // Slack for the f32 rounding of sums that differ in one term.
+            prop_assert!(err <= bound + 1e-5, "error {err} above bound {bound} (eps {eps})");
+        }
+    }
+}
+
+#[test]
+fn cutoff_skips_work_and_reports_a_nonzero_bound_on_hw3() {
+    let (scene, mut opts) = hw3_opts(64, 36, 1);
+    let exact = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    opts.cutoff = 0.2;
+    let cut = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    assert!(cut.stats.rays.total() < exact.stats.rays.total());
+    let max_bound = cut.cutoff_bound.iter().fold(0.0f32, |m, &b| m.max(b));
+    assert!(max_bound > 0.0);
+    assert_ne!(cut.frame, exact.frame);
+}
+
+#[test]
+fn adaptive_with_threshold_zero_is_full_anti_aliasing_bit_for_bit() {
+    for spp in [5, 9, 16] {
+        let (scene, mut opts) = hw3_opts(48, 27, spp);
+        let (full, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
+        // The viewer's path: passes of accumulate, then resolve.
+        let tracer = make_tracer(&scene, &opts).unwrap();
+        let mut sums = vec![Vec3::ZERO; 48 * 27];
+        let control = RenderControl::default();
+        accumulate(tracer.as_ref(), &opts, 0..2, &mut sums, &control).unwrap();
+        accumulate(tracer.as_ref(), &opts, 2..spp, &mut sums, &control).unwrap();
+        assert_eq!(resolve(&sums, spp, 48, 27), full, "accumulate, spp {spp}");
+
+        opts.adaptive = Some(Adaptive::with_threshold(0.0));
+        let adaptive = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+        assert_eq!(adaptive.refined, 48 * 27);
+        assert_eq!(adaptive.frame, full, "spp {spp}");
+    }
+}
+
+#[test]
+fn adaptive_region_is_the_crop_of_the_whole_image() {
+    let (scene, mut opts) = hw3_opts(64, 36, 16);
+    opts.adaptive = Some(Adaptive::with_threshold(0.05));
+    let (whole, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
+    for region in [
+        Region {
+            x: 0,
+            y: 0,
+            width: 64,
+            height: 36,
+        },
+        Region {
+            x: 10,
+            y: 5,
+            width: 17,
+            height: 9,
+        },
+        Region {
+            x: 63,
+            y: 35,
+            width: 1,
+            height: 1,
+        },
+        Region {
+            x: 0,
+            y: 20,
+            width: 30,
+            height: 16,
+        },
+    ] {
+        opts.region = Some(region);
+        let (part, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
+        for y in 0..region.height {
+            for x in 0..region.width {
+                // Frames count rows from the bottom; regions from the top.
+                let j_part = region.height - 1 - y;
+                let j_whole = 36 - 1 - (region.y + y);
+                assert_eq!(
+                    part.get(x, j_part),
+                    whole.get(region.x + x, j_whole),
+                    "region {region:?} pixel {x},{y}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn adaptive_refines_edges_not_flat_sky_and_stays_close_to_full_aa() {
+    let (scene, mut opts) = hw3_opts(96, 54, 16);
+    let (full, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
+    opts.adaptive = Some(Adaptive::with_threshold(0.03));
+    let a = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    let n = 96 * 54;
+    assert!(
+        a.refined > 0 && a.refined < n as u64 / 2,
+        "refined {}",
+        a.refined
+    );
+    // Unrefined pixels: the mean of 4 samples that agreed within the threshold, so
+    // within the threshold of the full mean wherever the pixel is smooth.
+    let far: usize = a
+        .frame
+        .pixels
+        .iter()
+        .zip(&full.pixels)
+        .filter(|(x, y)| (**x - **y).abs().max_element() > 0.03)
+        .count();
+    assert!(
+        far * 100 < n,
+        "{far} pixels differ by more than the threshold"
+    );
+
+    // Only sky, no ball: nothing but smooth gradients, so no pixel needs refining.
+    let mut sky = scene.clone();
+    sky.spheres.clear();
+    let b = render_bounded(&sky, &opts, &RenderControl::default()).unwrap();
+    assert_eq!(b.refined, 0);
+}
+
+#[test]
+fn first_pass_samples_spread_over_the_pixel() {
+    for (spp, first) in [(16, 4), (64, 4), (9, 4), (5, 4), (32, 9), (16, 1)] {
+        let ks = first_pass_samples(spp, first, 7);
+        assert_eq!(ks.len(), first as usize);
+        assert!(ks.windows(2).all(|w| w[0] < w[1]) && ks.iter().all(|&k| k < spp));
+        if first == 4 && spp >= 16 {
+            let mut quadrants: Vec<(bool, bool)> = ks
+                .iter()
+                .map(|&k| {
+                    let (x, y) = sample_offset(3, 4, k, spp, 7);
+                    (x < 0.5, y < 0.5)
+                })
+                .collect();
+            quadrants.sort();
+            quadrants.dedup();
+            assert_eq!(quadrants.len(), 4, "spp {spp}: {ks:?}");
+        }
+    }
+    assert_eq!(first_pass_samples(3, 4, 0), vec![0, 1, 2]);
+}
+
+#[test]
+fn every_preset_renders_and_better_presets_err_less() {
+    let (scene, base) = hw3_opts(32, 18, 1);
+    let reference = {
+        let opts = base.clone().with_quality(&Preset::Reference.quality());
+        render(&scene, &opts, &RenderControl::default()).unwrap().0
+    };
+    let mut errors = Vec::new();
+    for preset in Preset::ALL {
+        let q = preset.quality();
+        let opts = base.clone().with_quality(&q);
+        assert_eq!(Quality::of(&opts), q);
+        let (frame, stats) = render(&scene, &opts, &RenderControl::default())
+            .unwrap_or_else(|e| panic!("{preset}: {e}"));
+        assert!(frame.pixels.iter().all(|p| p.is_finite()), "{preset}");
+        assert!(stats.rays.total() > 0);
+        let sq: f32 = frame
+            .pixels
+            .iter()
+            .zip(&reference.pixels)
+            .map(|(a, b)| {
+                (a.clamp(Vec3::ZERO, Vec3::ONE) - b.clamp(Vec3::ZERO, Vec3::ONE)).length_squared()
+            })
+            .sum();
+        errors.push(sq);
+        assert_eq!(preset.name().parse::<Preset>(), Ok(preset));
+    }
+    assert_eq!(errors[3], 0.0, "the reference preset is the reference");
+    assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
+}
+
+#[test]
+fn unknown_preset_and_bad_knobs_are_clear_errors() {
+    let e = "fast".parse::<Preset>().unwrap_err();
+    assert!(
+        e.contains("fast") && e.contains("draft, default, high or reference"),
+        "{e}"
+    );
+    let (scene, mut opts) = hw3_opts(8, 8, 1);
+    opts.cutoff = f32::NAN;
+    assert!(render(&scene, &opts, &RenderControl::default()).is_err());
+    opts.cutoff = 0.0;
+    opts.adaptive = Some(Adaptive {
+        first: 0,
+        threshold: 0.1,
+    });
+    assert!(render(&scene, &opts, &RenderControl::default()).is_err());
+    opts.adaptive = Some(Adaptive::with_threshold(-1.0));
+    assert!(render(&scene, &opts, &RenderControl::default()).is_err());
+}
+
+#[test]
+fn reference_precision_ignores_the_cutoff() {
+    let (scene, mut opts) = hw3_opts(16, 9, 1);
+    opts.renderer = Renderer::Reference;
+    let (exact, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
+    opts.cutoff = 0.3;
+    let (cut, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
+    assert_eq!(exact, cut);
+}
+
+#[test]
+fn scene_file_quality_key_sets_the_preset_and_explicit_keys_win() {
+    let text = "[image]\nquality = \"default\"\nwidth = 16\nheight = 9\n\n\
+                [[sphere]]\ncenter = [0, 0, -2]\nradius = 0.5\n";
+    let scene = Scene::from_toml_str(text, "q.toml").unwrap();
+    let q = Preset::Default.quality();
+    assert_eq!(scene.image.quality, Some(Preset::Default));
+    assert_eq!(
+        (scene.image.spp, scene.image.max_depth),
+        (q.spp, q.max_depth)
+    );
+    assert_eq!(Quality::of(&RenderOptions::for_scene(&scene)), q);
+    // The written scene keeps the key and loads back the same.
+    let again = Scene::from_toml_str(&whitted::scene::to_toml(&scene), "w.toml").unwrap();
+    assert_eq!(again.image, scene.image);
+
+    let text =
+        "[image]\nquality = \"high\"\nspp = 4\n\n[[sphere]]\ncenter = [0, 0, -2]\nradius = 0.5\n";
+    let scene = Scene::from_toml_str(text, "q.toml").unwrap();
+    let opts = RenderOptions::for_scene(&scene);
+    assert_eq!(opts.image.spp, 4);
+    assert_eq!(opts.image.max_depth, Preset::High.quality().max_depth);
+    assert_eq!(opts.adaptive, Preset::High.quality().adaptive);
+
+    let text = "[image]\nquality = \"ultra\"\n";
+    let e = Scene::from_toml_str(text, "bad.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("bad.toml:2:"), "{e}");
+    assert!(
+        e.contains("ultra") && e.contains("draft, default, high or reference"),
+        "{e}"
+    );
+}
+
+#[test]
+fn scenes_without_the_key_render_as_before() {
+    let scene = hw3_scene(2020);
+    assert_eq!(scene.image.quality, None);
+    let opts = RenderOptions::for_scene(&scene);
+    assert_eq!(Quality::of(&opts), Quality::default());
+    assert_eq!(Quality::default(), Preset::Draft.quality());
+}
