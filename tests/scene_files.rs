@@ -127,13 +127,16 @@ fn another_seed_moves_only_the_small_balls() {
 fn writing_and_loading_round_trips() {
     let mut scene = parse(
         "[camera]\nlook_from = [1, 2, 3]\nlook_at = [0, 0.5, -1]\nup = [0, 1, 0]\nvfov = 40.5\n\
-         [image]\nwidth = 320\nheight = 200\nmax_depth = 3\nspp = 9\nseed = 11\n\
+         [image]\nwidth = 320\nheight = 200\nmax_depth = 3\nspp = 9\nseed = 11\nquality = \"high\"\n\
          [sky]\ndown = [0.1, 0.2, 0.3]\nup = [0.4, 0.5, 0.6]\n\
          [[light]]\nposition = [1, 1, 1]\nintensity = [0.5, 0.25, 2]\n\
          [[sphere]]\ncenter = [0.1, 0.2, 0.3]\nradius = 0.7\ncolor = [0.3, 0.6, 0.9]\n\
          reflect = 0.2\ntransmit = 0.7\nior = 1.33\n",
     );
     scene.name = "scene".into();
+    // The file's own spp and depth win over the preset's.
+    assert_eq!((scene.image.spp, scene.image.max_depth), (9, 3));
+    assert!(scene.image.quality.is_some());
     assert_eq!(parse(&to_toml(&scene)), scene);
     let framed = Scene {
         camera: Some(CameraSpec::assignment_frame()),
@@ -153,7 +156,8 @@ fn missing_tables_and_keys_take_the_defaults() {
             height: 720,
             max_depth: 5,
             spp: 1,
-            seed: 0
+            seed: 0,
+            quality: None
         }
     );
     assert_eq!(
