@@ -3,7 +3,7 @@
 //! written whole or not at all: into a temporary file beside the target, then renamed.
 
 use std::io::{Cursor, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use image::codecs::bmp::BmpEncoder;
 use image::codecs::jpeg::JpegEncoder;
@@ -113,46 +113,108 @@ pub fn encode_rgb8(image: &RgbImage, format: Format, out: &mut dyn Write) -> Res
     result.map_err(|e| e.to_string())
 }
 
+/// The folder a file at `path` goes into (`.` for a bare file name).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// A temporary file beside `path`, where [`write_atomically`] puts the bytes first.
+fn temp_file_for(path: &Path) -> Result<tempfile::NamedTempFile, SaveError> {
+    let dir = folder_of(path);
+    let err = |message: String| SaveError {
+        path: path.display().to_string(),
+        message,
+    };
+    match std::fs::metadata(dir) {
+        Err(e) => return Err(err(format!("cannot use the folder {}: {e}", dir.display()))),
+        Ok(m) if !m.is_dir() => {
+            return Err(err(format!("{} is not a folder", dir.display())));
+        }
+        Ok(_) => {}
+    }
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".whitted-").suffix(".part");
+    // tempfile makes private (0600) files; an image is an ordinary file, readable as
+    // the user's umask allows, like any file a program creates.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir).map_err(|e| {
+        // tempfile appends the random name it tried, which means nothing to the user.
+        let text = e.to_string();
+        let reason = text.split(" at path ").next().unwrap_or(&text);
+        err(format!("cannot write into {}: {reason}", dir.display()))
+    })
+}
+
+/// What a path to save to really is.
+enum Target {
+    /// A regular file, or nothing yet: replaced atomically at this path. A symbolic
+    /// link is resolved first, so that it keeps pointing at the new image.
+    File(PathBuf),
+    /// An existing device, FIFO or socket: it cannot be replaced (and must not be:
+    /// renaming over `/dev/full` would swallow the error), so it is written in place.
+    Special,
+}
+
+fn target_of(path: &Path) -> Target {
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() && !m.is_dir() => Target::Special,
+        Ok(_) => Target::File(std::fs::canonicalize(path).unwrap_or_else(|_| path.into())),
+        Err(_) => Target::File(path.into()),
+    }
+}
+
+/// Fails unless a file can be created in the folder of `path`: lets a command refuse
+/// an unwritable target before it spends time rendering. Leaves nothing behind.
+pub fn check_writable(path: &Path) -> Result<(), SaveError> {
+    if path.is_dir() {
+        return Err(SaveError {
+            path: path.display().to_string(),
+            message: "is a folder".into(),
+        });
+    }
+    match target_of(path) {
+        // Opening a FIFO would wait for a reader: the write will tell.
+        Target::Special => Ok(()),
+        Target::File(real) => temp_file_for(&real).map(drop),
+    }
+}
+
 /// Writes `bytes` into `path` atomically: a temporary file in the same folder, flushed
-/// and synced, then renamed over the target. On any error nothing is left behind.
+/// and synced, then renamed over the target. On any error nothing is left behind (the
+/// temporary file deletes itself when dropped). A device or FIFO is written in place.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
     let err = |message: String| SaveError {
         path: path.display().to_string(),
         message,
     };
-    // A target that exists and is not a regular file (a device such as /dev/full, a
-    // pipe) is written into directly: renaming over it would replace it.
-    if let Ok(meta) = std::fs::metadata(path) {
-        if meta.is_dir() {
-            return Err(err("is a folder".into()));
-        }
-        if !meta.is_file() {
-            let mut target = std::fs::OpenOptions::new()
+    if path.is_dir() {
+        return Err(err("is a folder".into()));
+    }
+    match target_of(path) {
+        Target::Special => {
+            let mut file = std::fs::OpenOptions::new()
                 .write(true)
                 .open(path)
                 .map_err(|e| err(e.to_string()))?;
-            return target
-                .write_all(bytes)
-                .and_then(|()| target.flush())
-                .map_err(|e| err(e.to_string()));
+            file.write_all(bytes)
+                .and_then(|()| file.flush())
+                .map_err(|e| err(e.to_string()))
+        }
+        Target::File(real) => {
+            let mut temp = temp_file_for(&real)?;
+            temp.write_all(bytes).map_err(|e| err(e.to_string()))?;
+            temp.as_file().sync_all().map_err(|e| err(e.to_string()))?;
+            temp.persist(&real).map_err(|e| err(e.error.to_string()))?;
+            Ok(())
         }
     }
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".whitted-").suffix(".part");
-    // Like any new file: 0666 less the umask, not the temporary file's private 0600.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut temp = builder
-        .tempfile_in(dir)
-        .map_err(|e| err(format!("cannot create a file in {}: {e}", dir.display())))?;
-    temp.write_all(bytes).map_err(|e| err(e.to_string()))?;
-    temp.as_file().sync_all().map_err(|e| err(e.to_string()))?;
-    temp.persist(path).map_err(|e| err(e.error.to_string()))?;
-    Ok(())
 }
 
 /// The frame encoded in `format`.

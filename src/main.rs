@@ -71,13 +71,15 @@ struct RenderArgs {
     scene: Option<PathBuf>,
     /// Output file, format by extension: .ppm .png .bmp .jpg .exr (repeatable).
     /// Default: output.ppm and output.png.
-    #[arg(short, long = "output", value_name = "FILE")]
+    #[arg(short, long = "output", value_name = "FILE", value_parser = parse_output)]
     output: Vec<PathBuf>,
     /// Write binary PPM (P6) instead of plain (P3).
     #[arg(long)]
     ppm_binary: bool,
+    /// Image width in pixels (overrides the scene's).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     width: Option<u32>,
+    /// Image height in pixels (overrides the scene's).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     height: Option<u32>,
     /// Samples per pixel.
@@ -161,13 +163,35 @@ fn parse_region(text: &str) -> Result<Region, String> {
     }
 }
 
+/// An output path whose extension names a format we write (else a usage error).
+fn parse_output(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    Format::from_path(&path, false)?;
+    Ok(path)
+}
+
+/// The built-in scene, embedded from the file the generator wrote
+/// (`whitted scene hw3 > assets/scenes/hw3.toml`); a test keeps the two in step.
+const BUILTIN_SCENE: &str = include_str!("../assets/scenes/hw3.toml");
+
+fn builtin_scene() -> anyhow::Result<Scene> {
+    let mut scene = Scene::from_toml_str(BUILTIN_SCENE, "assets/scenes/hw3.toml")
+        .context("the built-in scene is broken")?;
+    scene.name = "hw3".into();
+    Ok(scene)
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        Err(e) => {
-            let code = if e.use_stderr() { 2 } else { 0 };
+        Err(e) if !e.use_stderr() => {
+            // --help, --version
             let _ = e.print();
-            return ExitCode::from(code);
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("{}", usage_error_line(&e));
+            return ExitCode::from(2);
         }
     };
     let result = match cli.command {
@@ -180,10 +204,7 @@ fn main() -> ExitCode {
             runs,
             threads,
         }) => time_command(scene.as_deref(), runs, threads),
-        Some(Command::Scene { name: _, seed }) => {
-            print!("{}", scene::hw3_toml(seed));
-            Ok(())
-        }
+        Some(Command::Scene { name: _, seed }) => scene_command(seed),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -192,6 +213,19 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// clap's message on one line, like every other error: the error itself and its hints
+/// (a similar option, the possible values), without the usage block.
+fn usage_error_line(e: &clap::Error) -> String {
+    let text = e.to_string();
+    let parts: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    format!("{} (see --help)", parts.join("; "))
 }
 
 /// The error and its causes on one line.
@@ -205,7 +239,7 @@ fn one_line(e: &anyhow::Error) -> String {
 
 fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
     match path {
-        None => Ok(scene::hw3_scene(scene::HW3_DEFAULT_SEED)),
+        None => builtin_scene(),
         Some(p) => Ok(Scene::load(p)?),
     }
 }
@@ -221,6 +255,17 @@ fn view(path: Option<&Path>, quality: Option<Preset>) -> anyhow::Result<()> {
     whitted::viewer::run(scene)
 }
 
+fn scene_command(seed: u64) -> anyhow::Result<()> {
+    use std::io::Write;
+    let text = scene::hw3_toml(seed);
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        // A reader that stops early (`| head`) is not an error.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        result => result.context("cannot write the scene to standard output"),
+    }
+}
+
 fn time_command(path: Option<&Path>, runs: usize, threads: Option<u32>) -> anyhow::Result<()> {
     let scene = load_scene(path)?;
     let mut opts = RenderOptions::for_scene(&scene);
@@ -232,21 +277,18 @@ fn time_command(path: Option<&Path>, runs: usize, threads: Option<u32>) -> anyho
 }
 
 fn render_command(args: RenderArgs) -> anyhow::Result<()> {
-    // Output formats first: a bad extension is a usage error, found before any work.
     let outputs: Vec<PathBuf> = if args.output.is_empty() {
         vec!["output.ppm".into(), "output.png".into()]
     } else {
         args.output.clone()
     };
     let mut targets = Vec::new();
-    for path in &outputs {
-        match Format::from_path(path, args.ppm_binary) {
-            Ok(format) => targets.push((path.clone(), format)),
-            Err(message) => {
-                eprintln!("whitted: error: {message}");
-                std::process::exit(2);
-            }
-        }
+    for path in outputs {
+        // clap's parser has vetted every extension.
+        let format = Format::from_path(&path, args.ppm_binary).map_err(|m| anyhow!(m))?;
+        // A folder we cannot write into fails now, not after a long render.
+        image_io::check_writable(&path)?;
+        targets.push((path, format));
     }
 
     let scene = load_scene(args.scene.as_deref())?;

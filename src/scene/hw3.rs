@@ -124,5 +124,25 @@ pub fn hw3_toml(seed: u64) -> String {
          # (`whitted scene hw3 --seed {seed}`). No [camera] table: the assignment's camera\n\
          # applies (origin 0, lower-left (-4,-2.25,-1), spans (8,0,0) and (0,4.5,0) at 16:9).\n"
     );
-    header + &super::write::to_toml(&hw3_scene(seed))
+    // Label the spheres for a reader (the serializer writes no comments).
+    let labels = [
+        "# The ground.".to_string(),
+        "# The glass ball.".into(),
+        "# The mirror ball.".into(),
+        "# The diffuse orange ball.".into(),
+        format!("# 48 small balls from seed {seed}."),
+    ];
+    let body = super::write::to_toml(&hw3_scene(seed));
+    let mut out = header + "\n";
+    for (k, part) in body.split("[[sphere]]\n").enumerate() {
+        if k > 0 {
+            if let Some(label) = labels.get(k - 1) {
+                out.push_str(label);
+                out.push('\n');
+            }
+            out.push_str("[[sphere]]\n");
+        }
+        out.push_str(part);
+    }
+    out
 }

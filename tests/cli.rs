@@ -1,0 +1,296 @@
+//! The command line's contract (SPEC §5): exit status 0 on success, 2 for a usage
+//! error, 1 for anything else, with one clear line on stderr that says where (the
+//! file's line and column, or the field); and a failed write leaves no file behind.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn whitted(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_whitted"))
+        .args(args)
+        .output()
+        .expect("run whitted")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Exit status 1 with exactly one line on stderr that contains every `needle`.
+#[track_caller]
+fn assert_fails_with(out: &Output, needles: &[&str]) {
+    let err = stderr(out);
+    assert_eq!(out.status.code(), Some(1), "stderr: {err}");
+    assert_eq!(err.lines().count(), 1, "one line on stderr, got: {err}");
+    assert!(err.starts_with("whitted: error: "), "{err}");
+    for needle in needles {
+        assert!(err.contains(needle), "stderr lacks {needle:?}: {err}");
+    }
+}
+
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Writes `text` as `name` in a fresh folder and renders it into that folder.
+fn render_scene(name: &str, text: &str) -> (tempfile::TempDir, Output) {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join(name);
+    std::fs::write(&scene, text).unwrap();
+    let png = dir.path().join("out.png");
+    let out = whitted(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "9",
+    ]);
+    (dir, out)
+}
+
+#[test]
+fn bad_scene_files_exit_1_naming_the_place() {
+    // An unknown key: the key's line and column.
+    let (dir, out) = render_scene(
+        "unknown.toml",
+        "[[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\nshine = 3\n",
+    );
+    assert_fails_with(&out, &["unknown.toml:4:1", "shine"]);
+    assert_eq!(entries(dir.path()), ["unknown.toml"], "no image written");
+
+    // A wrong type: the value's line and column.
+    let (_, out) = render_scene(
+        "type.toml",
+        "[[sphere]]\ncenter = [0, 0, -1]\nradius = \"big\"\n",
+    );
+    assert_fails_with(&out, &["type.toml:3:10", "big"]);
+
+    // A NaN radius (TOML `nan`): the place and the field.
+    let (_, out) = render_scene(
+        "nan.toml",
+        "[image]\nwidth = 8\n\n[[sphere]]\ncenter = [0, 0, -1]\nradius = nan\n",
+    );
+    assert_fails_with(&out, &["nan.toml:6:10", "sphere 1", "radius"]);
+
+    // A bad value in the second sphere names that sphere.
+    let (_, out) = render_scene(
+        "weight.toml",
+        "[[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\n\n\
+         [[sphere]]\ncenter = [1, 0, -1]\nradius = 0.5\nreflect = 1.5\n",
+    );
+    assert_fails_with(&out, &["weight.toml:8:11", "sphere 2", "reflect"]);
+
+    // Not TOML at all.
+    let (_, out) = render_scene("broken.toml", "[[sphere]\ncenter = [0, 0, -1]\n");
+    assert_fails_with(&out, &["broken.toml:1:"]);
+}
+
+#[test]
+fn a_missing_scene_file_exits_1_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nowhere.toml");
+    let png = dir.path().join("out.png");
+    let out = whitted(&[
+        "render",
+        missing.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_fails_with(&out, &["nowhere.toml"]);
+    assert!(entries(dir.path()).is_empty());
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    for args in [
+        &["render", "--bogus"][..],
+        &["--bogus"],
+        &["render", "--width", "0"],
+        &["render", "--width", "wide"],
+        &["render", "--spp", "-1"],
+        &["render", "--region", "1,2,3"],
+        &["render", "--region", "0,0,0,5"],
+        &["render", "-o", "picture.gif"],
+        &["render", "-o", "no-extension"],
+        &["scene", "hw4"],
+        &["scene", "hw3", "--seed", "x"],
+        &["frobnicate"],
+    ] {
+        let out = whitted(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        // One line, like every other error.
+        let err = stderr(&out);
+        assert!(err.starts_with("error: "), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+    }
+    // The hints stay on that line: a similar option, the possible values.
+    let err = stderr(&whitted(&["render", "--widht", "5"]));
+    assert!(
+        err.contains("'--widht'") && err.contains("'--width'"),
+        "{err}"
+    );
+    let err = stderr(&whitted(&["scene", "hw4"]));
+    assert!(err.contains("hw3"), "{err}");
+    // Help and version are not errors.
+    for args in [&["--help"][..], &["render", "--help"], &["--version"]] {
+        let out = whitted(args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        assert!(!out.stdout.is_empty());
+    }
+}
+
+#[test]
+fn a_region_outside_the_image_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("out.png");
+    let out = whitted(&[
+        "render",
+        "--width",
+        "50",
+        "--height",
+        "50",
+        "--region",
+        "45,0,10,10",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_fails_with(&out, &["region", "50x50"]);
+    assert!(entries(dir.path()).is_empty());
+}
+
+#[test]
+fn output_into_a_missing_folder_exits_1_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("missing/out.png");
+    let ppm = dir.path().join("good.ppm");
+    let out = whitted(&[
+        "render",
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "-o",
+        ppm.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_fails_with(&out, &["missing"]);
+    // Checked before rendering: not even the writable target was written.
+    assert!(entries(dir.path()).is_empty(), "{:?}", entries(dir.path()));
+}
+
+#[test]
+fn output_into_a_read_only_folder_exits_1_and_leaves_nothing() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let ro = dir.path().join("ro");
+    std::fs::create_dir(&ro).unwrap();
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let target = ro.join("out.png");
+    let args = [
+        "render",
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "-o",
+        target.to_str().unwrap(),
+    ];
+
+    // root ignores folder permissions; without CAP_DAC_OVERRIDE (dropped by util-linux
+    // `setpriv`) it cannot write into a 0555 folder either.
+    let probe = ro.join("probe");
+    let out = if std::fs::write(&probe, b"").is_err() {
+        whitted(&args)
+    } else {
+        std::fs::remove_file(&probe).unwrap();
+        let drop_caps = ["--bounding-set=-dac_override,-dac_read_search", "--"];
+        let denied = Command::new("setpriv")
+            .args(drop_caps)
+            .args(["touch", probe.to_str().unwrap()])
+            .output()
+            .map(|o| !o.status.success())
+            .unwrap_or(false);
+        if !denied {
+            eprintln!(
+                "SKIPPED: output_into_a_read_only_folder: running as root and `setpriv` \
+                 cannot drop CAP_DAC_OVERRIDE here, so no folder is read-only"
+            );
+            return;
+        }
+        Command::new("setpriv")
+            .args(drop_caps)
+            .arg(env!("CARGO_BIN_EXE_whitted"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let listing = entries(&ro);
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
+    assert_fails_with(&out, &["ro", "ermission denied"]);
+    assert!(listing.is_empty(), "left behind: {listing:?}");
+}
+
+#[test]
+fn a_good_render_exits_0_with_a_closing_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("out.png");
+    let out = whitted(&[
+        "render",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let err = stderr(&out);
+    let last = err.lines().last().unwrap_or_default();
+    // e.g. "rendered hw3 32x18 (1 spp, depth 5) in 0.001 s: 3541 rays, 1.3 Mrays/s"
+    assert!(
+        last.starts_with("rendered hw3 32x18")
+            && last.contains(" rays, ")
+            && last.ends_with("Mrays/s"),
+        "closing line: {last}"
+    );
+    assert!(err.contains("wrote "), "{err}");
+    assert_eq!(entries(dir.path()), ["out.png"]);
+
+    // --quiet: nothing on stderr (and no progress bar when stderr is not a terminal).
+    let out = whitted(&[
+        "render",
+        "--quiet",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(out.stderr.is_empty(), "{}", stderr(&out));
+}
+
+#[test]
+fn scene_printing_fails_cleanly_when_stdout_cannot_be_written() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        eprintln!("SKIPPED: scene_printing_fails_cleanly: no /dev/full on this system");
+        return;
+    };
+    let out = Command::new(env!("CARGO_BIN_EXE_whitted"))
+        .args(["scene", "hw3"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    // A clear error and status 1, not a panic (status 101).
+    assert_fails_with(&out, &["standard output"]);
+}

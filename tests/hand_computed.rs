@@ -1,0 +1,475 @@
+//! Cases of the shading model (SPEC §2) whose answers are worked out by hand, here in
+//! the comments and in plain trigonometry: first the shared formulas of
+//! `whitted::model` in both precisions, then whole renders of tiny scenes through
+//! `Scene::from_toml_str` + `render::render`, with the fast tracer and the reference.
+
+use glam::{DVec3, Vec3};
+use whitted::model;
+use whitted::render::{self, Frame, RenderControl, RenderOptions, Renderer};
+use whitted::Scene;
+
+// ---------------------------------------------------------------------------------
+// The formulas
+// ---------------------------------------------------------------------------------
+
+fn close(a: DVec3, b: DVec3, tol: f64) -> bool {
+    (a - b).abs().max_element() <= tol
+}
+
+/// `sin` of the angle between a unit direction and the normal: `|d × n|`.
+fn sin_to_normal(d: DVec3, n: DVec3) -> f64 {
+    d.cross(n).length()
+}
+
+#[test]
+fn sky_at_straight_down_horizontal_and_straight_up() {
+    let (down, up) = (DVec3::ONE, DVec3::new(0.5, 0.7, 1.0));
+    // t = (d.y + 1)/2: 0 looking down (all `down`), 1/2 level, 1 looking up.
+    assert_eq!(model::sky(DVec3::NEG_Y, down, up), down);
+    assert_eq!(model::sky(DVec3::Y, down, up), up);
+    assert!(close(
+        model::sky(DVec3::NEG_Z, down, up),
+        DVec3::new(0.75, 0.85, 1.0),
+        1e-15
+    ));
+    let (down32, up32) = (Vec3::ONE, Vec3::new(0.5, 0.7, 1.0));
+    assert_eq!(model::sky(Vec3::NEG_Y, down32, up32), down32);
+    assert_eq!(model::sky(Vec3::Y, down32, up32), up32);
+    assert!(
+        (model::sky(Vec3::X, down32, up32) - Vec3::new(0.75, 0.85, 1.0))
+            .abs()
+            .max_element()
+            < 1e-7
+    );
+}
+
+#[test]
+fn reflect_mirrors_about_the_normal() {
+    let s = 0.5f64.sqrt();
+    // 45° down onto a floor comes back 45° up.
+    let r = model::reflect(DVec3::new(s, -s, 0.0), DVec3::Y);
+    assert!(close(r, DVec3::new(s, s, 0.0), 1e-15), "{r}");
+    // Head-on comes straight back.
+    assert_eq!(model::reflect(DVec3::NEG_Z, DVec3::Z), DVec3::Z);
+    // Any direction: same length, normal component flipped, tangent kept.
+    let n = DVec3::new(1.0, 2.0, -2.0) / 3.0;
+    let d = DVec3::new(0.3, -0.8, 0.52).normalize();
+    let r = model::reflect(d, n);
+    assert!((r.length() - 1.0).abs() < 1e-12);
+    assert!((r.dot(n) + d.dot(n)).abs() < 1e-12);
+    assert!(close(r - n * r.dot(n), d - n * d.dot(n), 1e-12));
+    let r32 = model::reflect(d.as_vec3(), n.as_vec3());
+    assert!(close(r32.as_dvec3(), r, 1e-6));
+}
+
+/// A ray from outside at `theta` from the normal `+y` of a surface, in the x-y plane.
+fn incoming(theta: f64) -> DVec3 {
+    DVec3::new(theta.sin(), -theta.cos(), 0.0)
+}
+
+#[test]
+fn entering_refraction_obeys_snells_law() {
+    let n = DVec3::Y;
+    for ior in [1.0, 1.33, 1.5, 2.0, 2.42] {
+        for deg in (0..90).step_by(3).map(f64::from).chain([89.9]) {
+            let d = incoming(deg.to_radians());
+            let (t, crosses) = model::transmit(d, n, true, ior);
+            assert!(
+                crosses,
+                "entering never reflects totally (ior {ior}, {deg}°)"
+            );
+            // sin θi = ior · sin θt, the ray goes on below the surface, in the plane of
+            // incidence, bent towards the normal.
+            let (si, st) = (sin_to_normal(d, n), sin_to_normal(t, n));
+            assert!(
+                (si - ior * st).abs() < 1e-6,
+                "ior {ior}, {deg}°: {si} vs {}",
+                ior * st
+            );
+            assert!((t.length() - 1.0).abs() < 1e-12);
+            assert!(t.dot(n) < 0.0 && t.z.abs() < 1e-12 && t.x >= 0.0);
+            // The same in f32.
+            let (t32, _) = model::transmit(d.as_vec3(), n.as_vec3(), true, ior as f32);
+            let st32 = sin_to_normal(t32.as_dvec3(), n);
+            assert!((si - ior * st32).abs() < 1e-6, "f32: ior {ior}, {deg}°");
+        }
+    }
+    // By hand: 60° into glass of index 1.5 gives sin θt = (√3/2)/1.5 = 0.5773503.
+    let (t, _) = model::transmit(incoming(60f64.to_radians()), n, true, 1.5);
+    assert!((t.x - 0.577_350_269_189_625_8).abs() < 1e-12, "{t}");
+    // Head-on goes straight through.
+    assert!(close(
+        model::transmit(DVec3::NEG_Y, n, true, 2.0).0,
+        DVec3::NEG_Y,
+        1e-15
+    ));
+}
+
+#[test]
+fn leaving_refraction_undoes_entering() {
+    let n = DVec3::Y;
+    for ior in [1.2, 1.5, 2.0] {
+        for deg in (0..90).step_by(5).map(f64::from) {
+            let d = incoming(deg.to_radians());
+            let (t, _) = model::transmit(d, n, true, ior);
+            // Run the refracted ray backwards: from inside, up through the same surface
+            // (d·n > 0, so not `front`). Light paths are reversible: out comes −d.
+            let (back, crosses) = model::transmit(-t, n, false, ior);
+            assert!(crosses);
+            assert!(close(back, -d, 1e-6), "ior {ior}, {deg}°: {back} vs {}", -d);
+            let (back32, _) = model::transmit((-t).as_vec3(), n.as_vec3(), false, ior as f32);
+            assert!(close(back32.as_dvec3(), -d, 1e-6), "f32: ior {ior}, {deg}°");
+            // Snell's law on the way out: sin θout = ior · sin θin.
+            assert!((sin_to_normal(back, n) - ior * sin_to_normal(t, n)).abs() < 1e-6);
+        }
+    }
+}
+
+#[test]
+fn total_internal_reflection_beyond_the_critical_angle() {
+    let n = DVec3::Y; // outward normal; the ray comes from inside (below), going up
+    let ior = 1.5; // critical angle asin(1/1.5) = 41.81°
+    for deg in [42.0, 50.0, 60.0, 75.0, 89.0] {
+        let theta = f64::to_radians(deg);
+        let d = DVec3::new(theta.sin(), theta.cos(), 0.0);
+        let (r, crosses) = model::transmit(d, n, false, ior);
+        assert!(!crosses, "{deg}° is beyond the critical angle");
+        // The mirror image, back down into the ball.
+        assert!(
+            close(r, DVec3::new(theta.sin(), -theta.cos(), 0.0), 1e-12),
+            "{deg}°: {r}"
+        );
+        let (r32, crosses32) = model::transmit(d.as_vec3(), n.as_vec3(), false, ior as f32);
+        assert!(!crosses32 && r32.is_finite());
+        assert!(close(r32.as_dvec3(), r, 1e-6));
+    }
+    // Just below the critical angle the ray still leaves, almost along the surface.
+    let theta = f64::to_radians(41.5);
+    let (t, crosses) = model::transmit(DVec3::new(theta.sin(), theta.cos(), 0.0), n, false, ior);
+    assert!(crosses && t.y > 0.0 && (t.x - 1.5 * theta.sin()).abs() < 1e-12);
+}
+
+#[test]
+fn shadow_factor_of_an_occluder() {
+    let l = DVec3::Z;
+    // Dead ahead: the shadow ray meets the occluder head-on, n_k = −L: (1 − 1)/2 = 0.
+    assert_eq!(model::occluder_factor(l, DVec3::NEG_Z), 0.0);
+    // Grazing: n_k ⟂ L: (1 + 0)/2 = 1/2.
+    assert_eq!(model::occluder_factor(l, DVec3::X), 0.5);
+    assert_eq!(model::occluder_factor(Vec3::Z, Vec3::Y), 0.5);
+    // 60° from head-on: (1 − cos 60°)/2 = 1/4.
+    let n = DVec3::new(0.75f64.sqrt(), 0.0, -0.5);
+    assert!((model::occluder_factor(l, n) - 0.25).abs() < 1e-15);
+}
+
+#[test]
+fn combine_mixes_local_reflected_and_transmitted() {
+    let (local, refl, trans) = (DVec3::X, DVec3::Y, DVec3::Z);
+    // (1 − w_t)((1 − w_r)·local + w_r·reflected) + w_t·transmitted
+    let c = model::combine(0.25, 0.5, local, refl, trans);
+    assert!(close(c, DVec3::new(0.375, 0.125, 0.5), 1e-15), "{c}");
+    assert_eq!(model::combine(0.0, 0.0, local, refl, trans), local);
+    assert_eq!(model::combine(1.0, 0.0, local, refl, trans), refl);
+    assert_eq!(model::combine(0.3, 1.0, local, refl, trans), trans);
+    // w_r + w_t > 1 is allowed and stays a convex mix (SPEC §3).
+    let c = model::combine(0.9, 0.9, DVec3::ONE, DVec3::ONE, DVec3::ONE);
+    assert!(close(c, DVec3::ONE, 1e-15));
+}
+
+// ---------------------------------------------------------------------------------
+// Whole renders of tiny scenes
+// ---------------------------------------------------------------------------------
+
+/// A camera at the origin looking down −z whose 1×1 (or centre) pixel sees exactly
+/// −z: `LL + H/2 + V/2 − O = (0, 0, −1)`.
+const CAMERA: &str = "[camera]
+origin = [0, 0, 0]
+lower_left = [-1, -1, -1]
+horizontal = [2, 0, 0]
+vertical = [0, 2, 0]
+";
+
+/// Renders the scene with both renderers; returns (fast, reference).
+fn render_both(toml: &str) -> (Frame, Frame) {
+    let scene = Scene::from_toml_str(toml, "test.toml").expect("a valid test scene");
+    let mut opts = RenderOptions::for_scene(&scene);
+    let control = RenderControl::default();
+    let (fast, _) = render::render(&scene, &opts, &control).expect("fast render");
+    opts.renderer = Renderer::Reference;
+    let (reference, _) = render::render(&scene, &opts, &control).expect("reference render");
+    (fast, reference)
+}
+
+/// Asserts pixel `(i, j)` (j from the bottom) is `expected` in both renders.
+#[track_caller]
+fn assert_pixel(frames: &(Frame, Frame), i: u32, j: u32, expected: DVec3) {
+    let (fast, reference) = (frames.0.get(i, j).as_dvec3(), frames.1.get(i, j).as_dvec3());
+    // The frame stores f32: the reference's f64 result rounded, within 6e-8.
+    assert!(
+        close(reference, expected, 1e-7),
+        "reference {reference} vs {expected}"
+    );
+    // f32 arithmetic: a few rounding errors of values near 1, far below one 8-bit
+    // level (1/255 = 3.9e-3).
+    assert!(close(fast, expected, 1e-5), "fast {fast} vs {expected}");
+}
+
+/// The default sky for a unit direction with vertical component `y`.
+fn default_sky(y: f64) -> DVec3 {
+    let t = 0.5 * (y + 1.0);
+    DVec3::ONE * (1.0 - t) + DVec3::new(0.5, 0.7, 1.0) * t
+}
+
+#[test]
+fn single_sphere_and_light_by_hand() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 3
+height = 3
+
+[[light]]
+position = [2, 0, 0]
+intensity = [1.0, 0.8, 0.5]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+color = [1.0, 0.5, 0.25]
+"
+    );
+    let frames = render_both(&toml);
+    // Centre pixel (1, 1): s = t = 1.5/3 = 1/2, so d = (0, 0, −1). It meets the sphere
+    // at p = (0, 0, −2), normal n = (0, 0, 1). To the light: P − p = (2, 0, 2), so
+    // L = (1, 0, 1)/√2 and n·L = 1/√2. The segment p→P leaves the sphere outwards and
+    // meets nothing: s = 1. Colour = kd ⊙ I · (1/√2)
+    //   = (1·1, 0.5·0.8, 0.25·0.5)/√2 = (0.7071068, 0.2828427, 0.0883883),
+    // 8-bit: round(·255) = (180, 72, 23).
+    let r = 0.5f64.sqrt();
+    let centre = DVec3::new(r, 0.4 * r, 0.125 * r);
+    assert_pixel(&frames, 1, 1, centre);
+    let bytes = whitted::image_io::to_rgb8(&frames.0);
+    assert_eq!(bytes.get_pixel(1, 1).0, [180, 72, 23]);
+    // Bottom-left pixel (0, 0): s = t = 1/6, d ∝ (−2/3, −2/3, −1), 43° off the axis,
+    // outside the sphere's 19.5° (asin 1/3): sky with d.y = −(2/3)/√(17/9) = −0.48507.
+    assert_pixel(
+        &frames,
+        0,
+        0,
+        default_sky(-(2.0 / 3.0) / (17.0f64 / 9.0).sqrt()),
+    );
+    // Top-left pixel (0, 2) looks as far up: d.y = +0.48507.
+    assert_pixel(
+        &frames,
+        0,
+        2,
+        default_sky((2.0 / 3.0) / (17.0f64 / 9.0).sqrt()),
+    );
+    // Image bytes put the top row first: byte row 0 is frame row 2, and the two
+    // differ (d.y = ±0.485 give different skies).
+    let to_bytes = |c: Vec3| c.to_array().map(whitted::image_io::to_byte);
+    assert_eq!(bytes.get_pixel(0, 0).0, to_bytes(frames.0.get(0, 2)));
+    assert_eq!(bytes.get_pixel(0, 2).0, to_bytes(frames.0.get(0, 0)));
+    assert_ne!(bytes.get_pixel(0, 0), bytes.get_pixel(0, 2));
+}
+
+#[test]
+fn half_mirror_sphere_by_hand() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 1
+height = 1
+
+[[light]]
+position = [2, 0, 0]
+intensity = [1.0, 0.8, 0.5]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+color = [1.0, 0.5, 0.25]
+reflect = 0.5
+"
+    );
+    // As above, local = (1, 0.4, 0.125)/√2. Head-on, d − 2(d·n)n = (0, 0, 1): back past
+    // the camera to the sky at d.y = 0, (0.75, 0.85, 1). Half of each.
+    let local = DVec3::new(1.0, 0.4, 0.125) * 0.5f64.sqrt();
+    let expected = local * 0.5 + DVec3::new(0.75, 0.85, 1.0) * 0.5;
+    assert_pixel(&render_both(&toml), 0, 0, expected);
+}
+
+#[test]
+fn glass_ball_refracts_in_and_out_by_hand() {
+    // The ray leaves the camera at α = asin 0.2 above −z: d = (0, tan α, −1)/|·|. The
+    // ball (centre (0,0,−3), radius 1, index 1.5) lies 3 away, so the ray passes
+    // 3·sin α = 0.6 from its centre and meets it at θi = asin 0.6 from the normal. Inside,
+    // sin θt = 0.6/1.5 = 0.4; the chord is symmetric, so it leaves at θi again. Each
+    // crossing turns the ray towards the axis by θi − θt: it leaves at α − 2(θi − θt)
+    // = 11.537° − 26.576° = −15.039° from −z, d.y = sin(−15.039°) = −0.2596, and sees the
+    // sky there (transmit = 1: no local or reflected light).
+    let alpha = 0.2f64.asin();
+    let camera = format!(
+        "[camera]
+origin = [0, 0, 0]
+lower_left = [-1, {}, -1]
+horizontal = [2, 0, 0]
+vertical = [0, 2, 0]
+",
+        alpha.tan() - 1.0
+    );
+    let toml = format!(
+        "{camera}
+[image]
+width = 1
+height = 1
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+transmit = 1
+ior = 1.5
+"
+    );
+    let (ti, tt) = (0.6f64.asin(), 0.4f64.asin());
+    let out = alpha - 2.0 * (ti - tt);
+    assert!((out.sin() + 0.2596).abs() < 1e-4);
+    assert_pixel(&render_both(&toml), 0, 0, default_sky(out.sin()));
+}
+
+#[test]
+fn total_internal_reflection_inside_a_glass_ball_by_hand() {
+    // The camera sits inside a glass ball (centre 0, radius 1, index 2) at y = 0.9 and
+    // looks down −z. The ray passes 0.9 from the centre, so it meets the surface at
+    // θ = asin 0.9 = 64.16° from the normal, beyond the critical angle asin(1/2) = 30°:
+    // total internal reflection. A mirrored chord keeps its distance to the centre, so
+    // every later hit reflects too, and each turns the ray by the chord's central angle
+    // π − 2θ (in the y-z plane, from the direction angle π of −z). With max_depth m
+    // the ray is reflected m times and then returns the sky of its direction.
+    let theta = 0.9f64.asin();
+    for max_depth in 0..=4u32 {
+        let toml = format!(
+            "[camera]
+origin = [0, 0.9, 0]
+lower_left = [-1, -0.1, -1]
+horizontal = [2, 0, 0]
+vertical = [0, 2, 0]
+
+[image]
+width = 1
+height = 1
+max_depth = {max_depth}
+
+[[sphere]]
+center = [0, 0, 0]
+radius = 1
+transmit = 1
+ior = 2
+"
+        );
+        let angle =
+            std::f64::consts::PI + f64::from(max_depth) * (std::f64::consts::PI - 2.0 * theta);
+        let frames = render_both(&toml);
+        let (fast, reference) = (frames.0.get(0, 0).as_dvec3(), frames.1.get(0, 0).as_dvec3());
+        let expected = default_sky(angle.sin());
+        assert!(
+            close(reference, expected, 1e-7),
+            "depth {max_depth}: {reference} vs {expected}"
+        );
+        // Each bounce in f32 loses a little; a few bounces stay well within 1e-5.
+        assert!(
+            close(fast, expected, 1e-5),
+            "depth {max_depth}: {fast} vs {expected}"
+        );
+    }
+}
+
+/// A white-ish ball at (0, 0, −5) seen head-on at p = (0, 0, −4), normal (0, 0, 1); the
+/// light at (0, 0, 6) straight behind the camera: L = (0, 0, 1), n·L = 1, so the pixel
+/// is 0.6 · s where s is the shadow factor of what lies on the segment p → light.
+fn shadow_scene(occluder: &str) -> String {
+    format!(
+        "{CAMERA}
+[image]
+width = 1
+height = 1
+
+[[light]]
+position = [0, 0, 6]
+
+[[sphere]]
+center = [0, 0, -5]
+radius = 1
+color = [0.6, 0.6, 0.6]
+{occluder}"
+    )
+}
+
+#[test]
+fn shadow_factor_in_whole_renders() {
+    // Nothing in the way: s = 1.
+    assert_pixel(&render_both(&shadow_scene("")), 0, 0, DVec3::splat(0.6));
+
+    // A ball dead ahead on the segment, centred on it at z = 3 (behind the camera, so
+    // the camera still sees the lit ball): the segment first crosses it at z = 2, where
+    // its normal is (0, 0, −1) = −L: s = (1 − 1)/2 = 0, black.
+    let dead_ahead = "[[sphere]]\ncenter = [0, 0, 3]\nradius = 1\n";
+    assert_pixel(&render_both(&shadow_scene(dead_ahead)), 0, 0, DVec3::ZERO);
+
+    // A ball that the segment only grazes: centre 0.999 to the side, so the segment
+    // runs h = √(1 − 0.999²) = 0.0447 inside it either side of z = 3. It first crosses
+    // at (0, 0, 3 − h), normal (−0.999, 0, −h): L·n = −h, s = (1 − h)/2 = 0.4776, about
+    // one half.
+    let grazing = "[[sphere]]\ncenter = [0.999, 0, 3]\nradius = 1\n";
+    let h = (1.0f64 - 0.999 * 0.999).sqrt();
+    let s = (1.0 - h) / 2.0;
+    assert!((s - 0.5).abs() < 0.025);
+    let frames = render_both(&shadow_scene(grazing));
+    let (fast, reference) = (frames.0.get(0, 0).as_dvec3(), frames.1.get(0, 0).as_dvec3());
+    assert!(close(reference, DVec3::splat(0.6 * s), 1e-7), "{reference}");
+    // Near a grazing hit f32 positions lose digits of h; 1e-4 is a tenth of a level.
+    assert!(close(fast, DVec3::splat(0.6 * s), 1e-4), "{fast}");
+
+    // The same ball beyond the light (z = 10 > 6) casts nothing: the segment stops at
+    // the light (the assignment counted casters beyond it).
+    let beyond = "[[sphere]]\ncenter = [0, 0, 10]\nradius = 1\n";
+    assert_pixel(&render_both(&shadow_scene(beyond)), 0, 0, DVec3::splat(0.6));
+
+    // No light at all: `light = []` leaves only black on the ball.
+    let dark = format!(
+        "light = []\n{}",
+        shadow_scene("").replace("[[light]]\nposition = [0, 0, 6]\n", "")
+    );
+    assert_pixel(&render_both(&dark), 0, 0, DVec3::ZERO);
+}
+
+#[test]
+fn sky_in_whole_renders() {
+    // An empty scene, looking straight down, level and straight up: the centre ray is
+    // look_at − look_from, so the pixel is sky(d) at d.y = −1, 0, 1.
+    for (look_at, up, y) in [
+        ("[0, -1, 0]", "[0, 0, -1]", -1.0),
+        ("[0, 0, -1]", "[0, 1, 0]", 0.0),
+        ("[0, 1, 0]", "[0, 0, -1]", 1.0),
+    ] {
+        let toml = format!(
+            "sphere = []
+[camera]
+look_from = [0, 0, 0]
+look_at = {look_at}
+up = {up}
+vfov = 90
+
+[image]
+width = 1
+height = 1
+"
+        );
+        assert_pixel(&render_both(&toml), 0, 0, default_sky(y));
+        // A scene's own sky colours: t = (y + 1)/2 between down and up.
+        let custom = format!("{toml}\n[sky]\ndown = [0.2, 0.4, 0.6]\nup = [1, 0, 0.5]\n");
+        let t = 0.5 * (y + 1.0);
+        let expected = DVec3::new(0.2, 0.4, 0.6) * (1.0 - t) + DVec3::new(1.0, 0.0, 0.5) * t;
+        assert_pixel(&render_both(&custom), 0, 0, expected);
+    }
+}
