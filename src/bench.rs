@@ -11,12 +11,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use glam::{DVec3, Vec3};
-use rand_mt::Mt64;
 
 use crate::image_io::{to_byte, to_rgb8};
 use crate::quality::{Adaptive, Preset, Quality};
 use crate::render::{render_bounded, Frame, RenderControl, RenderOptions, Renderer};
-use crate::scene::{hw3_scene, CameraSpec, Light, Scene, Sphere, HW3_DEFAULT_SEED};
+use crate::scene::{hw3_scene, many_scene, Scene, HW3_DEFAULT_SEED};
 
 /// A scene of the study.
 #[derive(Clone, Debug)]
@@ -66,70 +65,6 @@ pub fn study_scenes(tiny: bool) -> Vec<BenchScene> {
             scene: glass,
         },
     ]
-}
-
-/// `n` random balls (radius 0.1–0.3) resting on a ground sphere of radius 1000, with
-/// a big glass, mirror and diffuse ball, seen from afar: the layout of the peers'
-/// `make_hw3.py --many` (drawn from a different generator).
-pub fn many_scene(n: usize) -> Scene {
-    const PALETTE: [[f64; 3]; 8] = [
-        [0.8, 0.3, 0.3],
-        [0.3, 0.8, 0.3],
-        [0.3, 0.3, 0.8],
-        [0.8, 0.8, 0.3],
-        [0.3, 0.8, 0.8],
-        [0.8, 0.3, 0.8],
-        [0.8, 0.8, 0.8],
-        [0.3, 0.3, 0.3],
-    ];
-    let ground_r = 1000.0;
-    let mut spheres = vec![
-        Sphere::new(DVec3::new(0.0, -ground_r, 0.0), ground_r),
-        Sphere {
-            transmit: 0.9,
-            ..Sphere::new(DVec3::new(0.0, 3.0, 0.0), 3.0)
-        },
-        Sphere {
-            reflect: 0.9,
-            ..Sphere::new(DVec3::new(9.0, 3.0, -6.0), 3.0)
-        },
-        Sphere {
-            color: DVec3::new(1.0, 0.7, 0.3),
-            ..Sphere::new(DVec3::new(-9.0, 3.0, -6.0), 3.0)
-        },
-    ];
-    let mut rng = Mt64::new(n as u64);
-    let mut unit = || (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-    for _ in 0..n {
-        let x = unit() * 100.0 - 50.0;
-        let z = unit() * 100.0 - 50.0;
-        let r = 0.1 + 0.2 * unit();
-        let color = DVec3::from(PALETTE[(unit() * 8.0) as usize % 8]);
-        let kind = (unit() * 3.0) as u32;
-        let w = unit();
-        let y = -ground_r + ((ground_r + r).powi(2) - x * x - z * z).sqrt();
-        spheres.push(Sphere {
-            color,
-            reflect: if kind == 0 { w } else { 0.0 },
-            transmit: if kind == 1 { w } else { 0.0 },
-            ..Sphere::new(DVec3::new(x, y, z), r)
-        });
-    }
-    // From the built-in scene, so that fields added to scenes keep their defaults.
-    let mut scene = hw3_scene(HW3_DEFAULT_SEED);
-    scene.name = format!("many_{n}");
-    scene.camera = Some(CameraSpec::LookAt {
-        look_from: DVec3::new(0.0, 18.0, 60.0),
-        look_at: DVec3::new(0.0, 0.0, -8.0),
-        up: DVec3::Y,
-        vfov: 45.0,
-    });
-    scene.lights = vec![Light {
-        position: DVec3::new(-30.0, 60.0, 40.0),
-        intensity: DVec3::ONE,
-    }];
-    scene.spheres = spheres;
-    scene
 }
 
 /// One setting of the grid; `preset` names it when it is a preset's.
