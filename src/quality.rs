@@ -163,13 +163,8 @@ impl Preset {
     /// (`whitted bench`); re-run it before changing them.
     pub fn quality(self) -> Quality {
         match self {
-            Preset::Draft => Quality {
-                spp: 1,
-                adaptive: None,
-                cutoff: 0.0,
-                max_depth: 5,
-                precision: Renderer::Fast,
-            },
+            // The SPEC's defaults: what a render without options does.
+            Preset::Draft => Quality::default(),
             Preset::Default => Quality {
                 spp: 16,
                 adaptive: Some(Adaptive::with_threshold(0.1)),

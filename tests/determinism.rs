@@ -2,22 +2,12 @@
 //! the render region (a region equals the same crop of the whole image bit for bit),
 //! and with anti-aliasing only on the seed. Checked through the `whitted` binary.
 
+mod common;
+use common::whitted;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use image::{GenericImageView, Rgb32FImage};
-
-fn whitted(args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .args(args)
-        .output()
-        .expect("run whitted");
-    assert!(
-        out.status.success(),
-        "whitted {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
 
 /// Renders the built-in scene at 160×90 with `extra` options into `dir/name`.
 fn render(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {

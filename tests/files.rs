@@ -3,6 +3,9 @@
 //! every file is upright (top row sky, bottom row ground). Saving never leaves a
 //! partial or temporary file behind.
 
+mod common;
+use common::whitted;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -23,18 +26,6 @@ fn library_frame() -> Frame {
     render::render(&scene, &opts, &RenderControl::default())
         .expect("render")
         .0
-}
-
-fn whitted(args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .args(args)
-        .output()
-        .expect("run whitted");
-    assert!(
-        out.status.success(),
-        "whitted {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
 }
 
 /// Every pixel of the top row is sky (clearly bluer than red: the sky blends white into

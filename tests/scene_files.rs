@@ -2,8 +2,10 @@
 //! and what the binary renders; the loader's defaults, integer literals, both camera
 //! forms and an empty light list.
 
+mod common;
+use common::whitted;
+
 use std::path::Path;
-use std::process::Command;
 
 use glam::DVec3;
 use whitted::camera::Camera;
@@ -14,19 +16,6 @@ use whitted::scene::{
 use whitted::Scene;
 
 const ASSET: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/hw3.toml");
-
-fn whitted(args: &[&str]) -> Vec<u8> {
-    let out = Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .args(args)
-        .output()
-        .expect("run whitted");
-    assert!(
-        out.status.success(),
-        "whitted {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
-}
 
 fn parse(text: &str) -> Scene {
     Scene::from_toml_str(text, "test.toml").unwrap_or_else(|e| panic!("{e}"))
