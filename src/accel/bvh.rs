@@ -3,6 +3,7 @@
 //! parent), traversed near child first. It only proposes candidates; the exact
 //! sphere tests decide.
 
+use arrayvec::ArrayVec;
 use glam::Vec3;
 use wide::{f32x4, CmpLe};
 
@@ -118,11 +119,10 @@ impl Bvh {
         let inv = [finite(inv_d.x), finite(inv_d.y), finite(inv_d.z)];
         let o4 = [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)];
         let inv4 = inv.map(f32x4::splat);
-        let mut stack = [(0u32, 0.0f32); STACK];
-        let mut top = 1usize;
-        while top > 0 {
-            top -= 1;
-            let (node, t_enter) = stack[top];
+        // Not zeroed: a zeroed 2 KiB array cost more than the traversal of a short ray.
+        let mut stack: ArrayVec<(u32, f32), STACK> = ArrayVec::new();
+        stack.push((0, 0.0));
+        while let Some((node, t_enter)) = stack.pop() {
             if t_enter > t_max {
                 continue;
             }
@@ -150,7 +150,15 @@ impl Bvh {
                 }
             }
             let order = &mut order[..k];
-            order.sort_unstable_by(|&a, &b| near[a].total_cmp(&near[b]));
+            // Insertion sort by entry distance: at most four lanes (a library sort is
+            // not inlined and costs more than the node test).
+            for a in 1..k {
+                let mut b = a;
+                while b > 0 && near[order[b - 1]] > near[order[b]] {
+                    order.swap(b - 1, b);
+                    b -= 1;
+                }
+            }
             for &lane in order.iter() {
                 if n.count[lane] > 0 && near[lane] <= t_max {
                     let first = n.child[lane] as usize;
@@ -163,8 +171,7 @@ impl Bvh {
             }
             for &lane in order.iter().rev() {
                 if n.count[lane] == 0 {
-                    stack[top] = (n.child[lane], near[lane]);
-                    top += 1;
+                    stack.push((n.child[lane], near[lane]));
                 }
             }
         }

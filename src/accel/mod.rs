@@ -83,8 +83,65 @@ fn grid_resolution(spheres: usize) -> u32 {
     }
 }
 
-/// A directional grid around a camera origin (see [`Spheres::eye_grid`]).
-pub struct EyeGrid(DirGrid);
+/// A directional grid around a camera origin (see [`Spheres::eye_grid`]), with what
+/// the quick test of a primary ray needs of each sphere worked out once: every primary
+/// ray starts at the grid's centre, so only the direction varies.
+pub struct EyeGrid {
+    grid: DirGrid,
+    quick: Vec<EyeQuick>,
+}
+
+/// One sphere as the primary rays' quick test sees it (see [`EyeQuick::may_cross`]).
+#[derive(Clone, Copy)]
+struct EyeQuick {
+    /// `eye − centre` in `f32`.
+    f: Vec3,
+    /// A ray of unit direction `d` misses when `(f·d)²` is below this: the closest
+    /// point of its line is then farther than the (widened) radius plus the slack.
+    min_bp2: f32,
+    /// The (widened) radius plus slack: the crossings lie within `reach` of `−f·d`.
+    reach: f32,
+}
+
+impl EyeQuick {
+    fn new(eye: DVec3, centre: DVec3, quick: Vec4) -> Self {
+        // The quantities of `Spheres::may_cross` for this origin, with the test
+        // `|l|² > r² + slack` rewritten as `(f·d)² < |f|² − r² − slack`
+        // (`|l|² = |f|² − (f·d)²`). The rewrite adds rounding of a few ε·|f|², far
+        // below the slack of 2⁻¹⁸·(r² + |f|²), and the bound is rounded down.
+        let f = (eye - centre).as_vec3();
+        let (w, ff) = (f64::from(quick.w), f64::from(f.dot(f)));
+        let slack = f64::from(QUICK_SLACK) * (w * w + ff);
+        let min_bp2 = ff - w * w - 2.0 * slack;
+        let rounded = min_bp2 as f32;
+        let min_bp2 = if f64::from(rounded) > min_bp2 {
+            rounded.next_down()
+        } else {
+            rounded
+        };
+        let ff = f.dot(f);
+        EyeQuick {
+            f,
+            min_bp2,
+            reach: quick.w + QUICK_SLACK * (ff.sqrt() + quick.w),
+        }
+    }
+
+    /// `false` when a primary ray of direction `d` certainly misses the sphere in
+    /// `(0, t_max)`.
+    #[inline(always)]
+    fn may_cross(&self, d: Vec3, t_max: f32) -> bool {
+        let bp = -self.f.dot(d);
+        bp * bp >= self.min_bp2 && bp + self.reach > 0.0 && bp - self.reach < t_max
+    }
+}
+
+/// The `f32` centre and radius of the quick test, the radius widened to cover the
+/// centre's rounding.
+fn quick_sphere(c: DVec3, r: f64) -> Vec4 {
+    let widen = 4.0 * f64::from(f32::EPSILON) * (c.abs().max_element() + r);
+    c.as_vec3().extend((r + widen) as f32)
+}
 
 /// The spheres, for the fast tracer's queries.
 pub struct Spheres {
@@ -105,10 +162,7 @@ impl Spheres {
         let quick = center
             .iter()
             .zip(&radius)
-            .map(|(&c, &r)| {
-                let widen = 4.0 * f64::from(f32::EPSILON) * (c.abs().max_element() + r);
-                c.as_vec3().extend((r + widen) as f32)
-            })
+            .map(|(&c, &r)| quick_sphere(c, r))
             .collect();
         let boxes: Vec<Aabb> = center
             .iter()
@@ -184,21 +238,31 @@ impl Spheres {
                     .collect::<Vec<_>>()
             },
         );
-        let eye = EyeGrid(grids.remove(0));
-        (
-            Spheres {
-                lights: grids,
-                ..base
-            },
-            eye,
-        )
+        let eye = grids.remove(0);
+        let spheres = Spheres {
+            lights: grids,
+            ..base
+        };
+        let eye = spheres.eye_grid_from(eye);
+        (spheres, eye)
+    }
+
+    fn eye_grid_from(&self, grid: DirGrid) -> EyeGrid {
+        let eye = grid.centre;
+        let quick = self
+            .center
+            .iter()
+            .zip(&self.quick)
+            .map(|(&c, &q)| EyeQuick::new(eye, c, q))
+            .collect();
+        EyeGrid { grid, quick }
     }
 
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
     /// the only part of the structures that depends on the camera.
     pub fn eye_grid(&self, eye: DVec3) -> EyeGrid {
         let list = self.centres_and_radii();
-        EyeGrid(DirGrid::build(eye, &list, grid_resolution(list.len())))
+        self.eye_grid_from(DirGrid::build(eye, &list, grid_resolution(list.len())))
     }
 
     pub fn len(&self) -> usize {
@@ -261,11 +325,17 @@ impl Spheres {
     /// Tests sphere `k` for the closest hit so far; returns the new `t` if it is closer.
     #[inline(always)]
     fn consider(&self, k: u32, ray: &Ray, best: &mut Best) -> Option<f32> {
-        let k = k as usize;
-        let own_outward = ray.from == Some((k as u32, Side::Outward));
-        if own_outward || !self.may_cross(k, ray, round_up(best.t)) {
+        let own_outward = ray.from == Some((k, Side::Outward));
+        if own_outward || !self.may_cross(k as usize, ray, round_up(best.t)) {
             return None;
         }
+        self.consider_exactly(k, ray, best)
+    }
+
+    /// [`Spheres::consider`] after the quick test passed.
+    #[inline(always)]
+    fn consider_exactly(&self, k: u32, ray: &Ray, best: &mut Best) -> Option<f32> {
+        let k = k as usize;
         let (t, entering, normal) = self.crossing(k, ray, best.t)?;
         *best = Best {
             t,
@@ -304,8 +374,8 @@ impl Spheres {
 
     /// The closest hit of a primary ray: a ray from the centre of `eye`.
     pub fn closest_primary(&self, eye: &EyeGrid, q: &Query) -> Option<Hit> {
-        let grid = &eye.0;
-        if grid.centre != q.origin {
+        let grid = &eye.grid;
+        if grid.centre != q.origin || q.from.is_some() {
             return self.closest(q);
         }
         let ray = Ray::new(q);
@@ -313,11 +383,16 @@ impl Spheres {
         for &k in &grid.always {
             self.consider(k, &ray, &mut best);
         }
+        let mut t_max = round_up(best.t);
         for &(k, near) in grid.candidates(grid.cell(q.dir)) {
-            if f64::from(near) >= best.t {
+            if near >= t_max {
                 break; // the rest are all farther
             }
-            self.consider(k, &ray, &mut best);
+            if eye.quick[k as usize].may_cross(q.dir, t_max) {
+                if let Some(t) = self.consider_exactly(k, &ray, &mut best) {
+                    t_max = t;
+                }
+            }
         }
         self.finish(best)
     }
