@@ -432,8 +432,9 @@ fn render_with<T: SampleTracer>(
             // Nothing is skipped, so every bound is 0: the pixels are written in place
             // (zeroed in parallel: on two cores a serial fill of a 1280×720 frame costs
             // a tenth of the render).
-            let mut pixels: Vec<Vec3> =
-                in_pool(opts, || (0..n).into_par_iter().map(|_| Vec3::ZERO).collect())?;
+            let mut pixels: Vec<Vec3> = in_pool(opts, || {
+                (0..n).into_par_iter().map(|_| Vec3::ZERO).collect()
+            })?;
             let rays = for_each_pixel(
                 opts,
                 area,
