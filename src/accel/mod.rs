@@ -83,33 +83,39 @@ fn grid_resolution(spheres: usize) -> u32 {
     }
 }
 
-/// A directional grid around a camera origin (see [`Spheres::eye_grid`]), with what
-/// the quick test of a primary ray needs of each sphere worked out once: every primary
-/// ray starts at the grid's centre, so only the direction varies.
-pub struct EyeGrid {
+/// A directional grid around a point (the camera origin or a light), with what the
+/// quick test of a ray through that point needs of each sphere worked out once: only
+/// the direction varies between such rays.
+pub struct PointGrid {
     grid: DirGrid,
-    quick: Vec<EyeQuick>,
+    quick: Vec<PointQuick>,
 }
 
-/// One sphere as the primary rays' quick test sees it (see [`EyeQuick::may_cross`]).
+/// The grid around a camera origin (see [`Spheres::eye_grid`]).
+pub type EyeGrid = PointGrid;
+
+/// One sphere as the quick test of rays through a grid's point sees it (see
+/// [`PointQuick::may_cross`]).
 #[derive(Clone, Copy)]
-struct EyeQuick {
-    /// `eye − centre` in `f32`.
+struct PointQuick {
+    /// `point − centre` in `f32`.
     f: Vec3,
     /// A ray of unit direction `d` misses when `(f·d)²` is below this: the closest
     /// point of its line is then farther than the (widened) radius plus the slack.
     min_bp2: f32,
     /// The (widened) radius plus slack: the crossings lie within `reach` of `−f·d`.
     reach: f32,
+    /// The widened radius.
+    radius: f32,
 }
 
-impl EyeQuick {
-    fn new(eye: DVec3, centre: DVec3, quick: Vec4) -> Self {
+impl PointQuick {
+    fn new(point: DVec3, centre: DVec3, quick: Vec4) -> Self {
         // The quantities of `Spheres::may_cross` for this origin, with the test
         // `|l|² > r² + slack` rewritten as `(f·d)² < |f|² − r² − slack`
         // (`|l|² = |f|² − (f·d)²`). The rewrite adds rounding of a few ε·|f|², far
         // below the slack of 2⁻¹⁸·(r² + |f|²), and the bound is rounded down.
-        let f = (eye - centre).as_vec3();
+        let f = (point - centre).as_vec3();
         let (w, ff) = (f64::from(quick.w), f64::from(f.dot(f)));
         let slack = f64::from(QUICK_SLACK) * (w * w + ff);
         let min_bp2 = ff - w * w - 2.0 * slack;
@@ -120,19 +126,31 @@ impl EyeQuick {
             rounded
         };
         let ff = f.dot(f);
-        EyeQuick {
+        PointQuick {
             f,
             min_bp2,
             reach: quick.w + QUICK_SLACK * (ff.sqrt() + quick.w),
+            radius: quick.w,
         }
     }
 
-    /// `false` when a primary ray of direction `d` certainly misses the sphere in
-    /// `(0, t_max)`.
+    /// `false` when a ray from the point with unit direction `d` certainly misses the
+    /// sphere in `(0, t_max)`.
     #[inline(always)]
     fn may_cross(&self, d: Vec3, t_max: f32) -> bool {
         let bp = -self.f.dot(d);
         bp * bp >= self.min_bp2 && bp + self.reach > 0.0 && bp - self.reach < t_max
+    }
+
+    /// [`PointQuick::may_cross`] for a ray whose line may pass up to `offset` from the
+    /// point (the sphere is widened by `offset`).
+    #[inline(always)]
+    fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
+        let bp = -self.f.dot(d);
+        let reach = self.reach + offset;
+        bp * bp + offset * (2.0 * self.radius + offset) >= self.min_bp2
+            && bp + reach > 0.0
+            && bp - reach < t_max
     }
 }
 
@@ -151,7 +169,7 @@ pub struct Spheres {
     quick: Vec<Vec4>,
     bvh: Bvh,
     /// Around each light, for shadow rays.
-    lights: Vec<DirGrid>,
+    lights: Vec<PointGrid>,
 }
 
 impl Spheres {
@@ -217,7 +235,7 @@ impl Spheres {
         let n = grid_resolution(list.len());
         self.lights = lights
             .par_iter()
-            .map(|&p| DirGrid::build(p, &list, n))
+            .map(|&p| self.point_grid(DirGrid::build(p, &list, n)))
             .collect();
         self
     }
@@ -229,7 +247,7 @@ impl Spheres {
         let list: Vec<(DVec3, f64)> = spheres.iter().map(|s| (s.center, s.radius)).collect();
         let n = grid_resolution(list.len());
         let points: Vec<DVec3> = std::iter::once(eye).chain(lights.iter().copied()).collect();
-        let (base, mut grids) = rayon::join(
+        let (base, grids) = rayon::join(
             || Spheres::new(spheres),
             || {
                 points
@@ -238,31 +256,34 @@ impl Spheres {
                     .collect::<Vec<_>>()
             },
         );
+        let mut grids: Vec<PointGrid> = grids.into_par_iter().map(|g| base.point_grid(g)).collect();
         let eye = grids.remove(0);
-        let spheres = Spheres {
-            lights: grids,
-            ..base
-        };
-        let eye = spheres.eye_grid_from(eye);
-        (spheres, eye)
+        (
+            Spheres {
+                lights: grids,
+                ..base
+            },
+            eye,
+        )
     }
 
-    fn eye_grid_from(&self, grid: DirGrid) -> EyeGrid {
-        let eye = grid.centre;
+    /// `grid` with the quick-test constants of its point.
+    fn point_grid(&self, grid: DirGrid) -> PointGrid {
+        let point = grid.centre;
         let quick = self
             .center
             .iter()
             .zip(&self.quick)
-            .map(|(&c, &q)| EyeQuick::new(eye, c, q))
+            .map(|(&c, &q)| PointQuick::new(point, c, q))
             .collect();
-        EyeGrid { grid, quick }
+        PointGrid { grid, quick }
     }
 
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
     /// the only part of the structures that depends on the camera.
     pub fn eye_grid(&self, eye: DVec3) -> EyeGrid {
         let list = self.centres_and_radii();
-        self.eye_grid_from(DirGrid::build(eye, &list, grid_resolution(list.len())))
+        self.point_grid(DirGrid::build(eye, &list, grid_resolution(list.len())))
     }
 
     pub fn len(&self) -> usize {
@@ -424,19 +445,32 @@ impl Spheres {
 
     /// The shadow factor along the segment of length `dist` towards light `light`.
     pub fn shadow_to_light(&self, q: &Query, dist: f64, light: usize) -> f32 {
-        let Some(grid) = self.lights.get(light) else {
+        let Some(lg) = self.lights.get(light) else {
             return self.shadow(q, dist);
         };
+        let grid = &lg.grid;
         let ray = Ray::new(q);
         let mut factor = 1.0f32;
         for &k in &grid.always {
             self.occlude(k, &ray, dist, &mut factor);
         }
+        // The quick test runs from the light, back along the segment: the line through
+        // the light with the (rounded) direction passes within this of the segment's
+        // start (the direction is off by at most ~1.5e-7 radians).
+        let offset = (4e-7 * dist) as f32;
+        let (back, dist32) = (-q.dir, round_up(dist));
         for &(k, near) in grid.candidates(grid.cell((q.origin - grid.centre).as_vec3())) {
             if f64::from(near) >= dist || factor <= 0.0 {
                 break; // beyond the hit point, seen from the light
             }
-            self.occlude(k, &ray, dist, &mut factor);
+            if ray.from == Some((k, Side::Outward))
+                || !lg.quick[k as usize].may_cross_near(back, dist32, offset)
+            {
+                continue;
+            }
+            if let Some((_, _, n_k)) = self.crossing(k as usize, &ray, dist) {
+                factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
+            }
         }
         factor
     }
