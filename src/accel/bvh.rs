@@ -94,9 +94,15 @@ impl Bvh {
         Bvh { nodes, items }
     }
 
-    /// Calls `visit(item)` for every item whose box the ray `o + t·d` (`inv_d = 1/d`)
-    /// meets within `[0, t_max]`, roughly nearest first; `visit` returns a lower `t_max`
-    /// when it finds a hit.
+    /// The items in leaf order: `traverse` visits slots of this list, so that data
+    /// the caller lays out in this order is read from consecutive addresses.
+    pub fn items(&self) -> &[u32] {
+        &self.items
+    }
+
+    /// Calls `visit(slot)` for every item (`items()[slot]`) whose box the ray `o + t·d`
+    /// (`inv_d = 1/d`) meets within `[0, t_max]`, roughly nearest first; `visit` returns
+    /// a lower `t_max` when it finds a hit.
     #[inline]
     pub fn traverse(
         &self,
@@ -161,9 +167,9 @@ impl Bvh {
             }
             for &lane in order.iter() {
                 if n.count[lane] > 0 && near[lane] <= t_max {
-                    let first = n.child[lane] as usize;
-                    for &item in &self.items[first..first + n.count[lane] as usize] {
-                        if let Some(t) = visit(item) {
+                    let first = n.child[lane];
+                    for slot in first..first + n.count[lane] {
+                        if let Some(t) = visit(slot) {
                             t_max = t_max.min(t);
                         }
                     }
