@@ -173,23 +173,32 @@ impl TracerCache {
 /// Renders all passes of `job`, reporting each; stops early when cancelled.
 pub fn run(job: &Job, cache: &mut TracerCache, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
     let scene = job.scene.as_ref();
-    let control = job.control.as_ref();
     let mut opts = RenderOptions::for_scene(scene);
     opts.image.width = job.width;
     opts.image.height = job.height;
     opts.check()?;
-    let (w, h) = (job.width, job.height);
-    let target = opts.image.spp;
     // The fast tracer comes from the cache; the f64 reference (a `reference` quality)
     // is built for each view.
-    let reference;
-    let tracer: &dyn SampleTracer = match opts.renderer {
-        Renderer::Fast => cache.tracer(&job.scene, &opts)?,
+    match opts.renderer {
+        Renderer::Fast => passes(job, cache.tracer(&job.scene, &opts)?, &opts, sink),
         Renderer::Reference => {
-            reference = render::make_tracer(scene, &opts)?;
-            reference.as_ref()
+            let reference = render::make_tracer(scene, &opts)?;
+            passes(job, reference.as_ref(), &opts, sink)
         }
-    };
+    }
+}
+
+/// The passes of `job` with `tracer` (generic, so that the fast tracer's samples are
+/// direct calls).
+fn passes<T: SampleTracer + ?Sized>(
+    job: &Job,
+    tracer: &T,
+    opts: &RenderOptions,
+    sink: &dyn Fn(Report),
+) -> Result<(), RenderError> {
+    let control = job.control.as_ref();
+    let (w, h) = (job.width, job.height);
+    let target = opts.image.spp;
     let mut sums = vec![Vec3::ZERO; w as usize * h as usize];
     let passes = plan(w, h, target, job.preview_factor);
     let last = passes.len() - 1;
@@ -219,7 +228,7 @@ pub fn run(job: &Job, cache: &mut TracerCache, sink: &dyn Fn(Report)) -> Result<
             Pass::Samples(range) => {
                 let end = range.end;
                 let pixels = u64::from(w) * u64::from(h) * range.len() as u64;
-                render::accumulate(tracer, &opts, range, &mut sums, control)?;
+                render::accumulate(tracer, opts, range, &mut sums, control)?;
                 (render::resolve(&sums, end, w, h), end, false, pixels)
             }
         };
