@@ -435,6 +435,9 @@ fn render_with<T: SampleTracer>(
             let mut pixels: Vec<Vec3> = in_pool(opts, || {
                 (0..n).into_par_iter().map(|_| Vec3::ZERO).collect()
             })?;
+            let centres: Vec<f32> = (area.x..area.x + area.width)
+                .map(|i| (i as f32 + 0.5) / opts.image.width as f32)
+                .collect();
             let rays = for_each_pixel(
                 opts,
                 area,
@@ -443,6 +446,14 @@ fn render_with<T: SampleTracer>(
                 u64::from(spp),
                 control,
                 |i, j, p, counts| {
+                    if spp == 1 {
+                        // The pixel centre: `film` for one sample, with the columns'
+                        // positions worked out once (same values, no division).
+                        let t = (j as f32 + 0.5) / opts.image.height as f32;
+                        let c = tracer.sample(centres[(i - area.x) as usize], t, counts);
+                        p[0] = if c.is_finite() { c } else { Vec3::ZERO };
+                        return;
+                    }
                     let mut sum = Vec3::ZERO;
                     for k in 0..spp {
                         let (s, t) = film(opts, i, j, k);

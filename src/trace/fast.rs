@@ -189,6 +189,11 @@ impl FastTracer {
                 }
             }
         }
+        if !m.branches.reflect && !m.branches.transmit {
+            // A diffuse surface: step 7 mixes `local` with weights 1 and 0, which gives
+            // `local` exactly.
+            return local;
+        }
         let w_reflect = weight * (1.0 - m.w_t) * m.w_r;
         let reflected = if m.branches.reflect && self.keep(w_reflect, skipped) {
             let dir = model::reflect(ray.dir, n).normalize();
