@@ -132,6 +132,7 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                     for (name, got) in [
                         ("closest", set.closest(&q)),
                         ("closest_primary", set.closest_primary(&eye_grid, &q)),
+                        ("closest_from_eye", set.closest_from_eye(&eye_grid, q.dir)),
                     ] {
                         let got_k = got.map(|h| h.sphere);
                         if got_k != want {
@@ -139,6 +140,16 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                             prop_assert!(false, "{name}: sphere {got_k:?}, f64 says {want:?}");
                         }
                     }
+                    // The eye's query with its precomputed constants is the general
+                    // query, to the bit.
+                    let (general, from_eye) = (
+                        set.closest_primary(&eye_grid, &q),
+                        set.closest_from_eye(&eye_grid, q.dir),
+                    );
+                    prop_assert_eq!(
+                        general.map(|h| (h.point, h.normal, h.entering)),
+                        from_eye.map(|h| (h.point, h.normal, h.entering))
+                    );
                     // A shadow ray from the hit towards the light, through grid and BVH.
                     let Some(hit) = set.closest(&q) else { continue };
                     c.hits += 1;

@@ -13,7 +13,7 @@ use dirgrid::DirGrid;
 
 use crate::model::Side;
 use crate::scene::Sphere;
-use crate::trace::intersect::roots;
+use crate::trace::intersect::{roots, roots_from};
 
 /// The closest hit of a ray.
 #[derive(Clone, Copy, Debug)]
@@ -89,6 +89,9 @@ fn grid_resolution(spheres: usize) -> u32 {
 pub struct PointGrid {
     grid: DirGrid,
     quick: Vec<PointQuick>,
+    /// Around the eye only: per sphere, `eye − centre` and `|eye − centre|² − r²` in
+    /// `f64`, the origin's part of the exact test.
+    exact: Vec<(DVec3, f64)>,
 }
 
 /// The grid around a camera origin (see [`Spheres::eye_grid`]).
@@ -279,7 +282,17 @@ impl Spheres {
                     .collect::<Vec<_>>()
             },
         );
-        let mut grids: Vec<PointGrid> = grids.into_par_iter().map(|g| base.point_grid(g)).collect();
+        let mut grids: Vec<PointGrid> = grids
+            .into_par_iter()
+            .enumerate()
+            .map(|(i, g)| {
+                if i == 0 {
+                    base.eye_point_grid(g)
+                } else {
+                    base.point_grid(g)
+                }
+            })
+            .collect();
         let eye = grids.remove(0);
         (
             Spheres {
@@ -299,14 +312,36 @@ impl Spheres {
             .zip(&self.quick)
             .map(|(&c, &q)| PointQuick::new(point, c, q))
             .collect();
-        PointGrid { grid, quick }
+        PointGrid {
+            grid,
+            quick,
+            exact: Vec::new(),
+        }
+    }
+
+    /// `grid` around the eye: [`Spheres::point_grid`] with the exact test's constants.
+    fn eye_point_grid(&self, grid: DirGrid) -> EyeGrid {
+        let eye = grid.centre;
+        let exact = self
+            .center
+            .iter()
+            .zip(&self.radius)
+            .map(|(&c, &r)| {
+                let f = eye - c;
+                (f, f.dot(f) - r * r)
+            })
+            .collect();
+        PointGrid {
+            exact,
+            ..self.point_grid(grid)
+        }
     }
 
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
     /// the only part of the structures that depends on the camera.
     pub fn eye_grid(&self, eye: DVec3) -> EyeGrid {
         let list = self.centres_and_radii();
-        self.point_grid(DirGrid::build(eye, &list, grid_resolution(list.len())))
+        self.eye_point_grid(DirGrid::build(eye, &list, grid_resolution(list.len())))
     }
 
     pub fn len(&self) -> usize {
@@ -430,6 +465,56 @@ impl Spheres {
                     t_max = t;
                 }
             }
+        }
+        self.finish(best)
+    }
+
+    /// [`Spheres::closest_primary`] for the ray from the eye with unit direction `d`,
+    /// with the origin's part of every test worked out beforehand (same results).
+    pub fn closest_from_eye(&self, eye: &EyeGrid, d: Vec3) -> Option<Hit> {
+        let grid = &eye.grid;
+        if !grid.always.is_empty() || eye.exact.is_empty() {
+            // The eye inside a sphere (rare): the general query.
+            let q = Query {
+                origin: grid.centre,
+                dir: d,
+                from: None,
+            };
+            return self.closest_primary(eye, &q);
+        }
+        let mut best = Best::NONE;
+        let mut t_max = f32::INFINITY;
+        // As in `crossing`: the direction renormalised in `f64`, once.
+        let mut d64 = None;
+        for &(k, near) in grid.candidates(grid.cell(d)) {
+            if near >= t_max {
+                break; // the rest are all farther
+            }
+            let k = k as usize;
+            if !eye.quick[k].may_cross(d, t_max) {
+                continue;
+            }
+            let d64 = *d64.get_or_insert_with(|| d.as_dvec3().normalize());
+            let (f, cterm) = eye.exact[k];
+            let r = self.radius[k];
+            let Some(rt) = roots_from(f, cterm, d64, r) else {
+                continue;
+            };
+            // `crossing` for a ray with no spawn sphere and `t_min = 0`.
+            let (t, entering, normal) = if rt.near > 0.0 && rt.near < best.t {
+                (rt.near, true, rt.normal_near(d64, r))
+            } else if rt.far > 0.0 && rt.far < best.t {
+                (rt.far, false, rt.normal_far(d64, r))
+            } else {
+                continue;
+            };
+            best = Best {
+                t,
+                k,
+                entering,
+                normal,
+            };
+            t_max = round_up(t);
         }
         self.finish(best)
     }

@@ -153,7 +153,7 @@ impl FastTracer {
             counts.secondary += 1;
         }
         let hit = if depth == 0 {
-            self.compiled.spheres.closest_primary(&self.eye, ray)
+            self.compiled.spheres.closest_from_eye(&self.eye, ray.dir)
         } else {
             self.compiled.spheres.closest(ray)
         };

@@ -34,6 +34,13 @@ impl<V: Vector> Roots<V> {
 #[inline]
 pub fn roots<V: Vector>(o: V, d: V, c: V, r: V::R) -> Option<Roots<V>> {
     let f = o - c;
+    roots_from(f, f.dot(f) - r * r, d, r)
+}
+
+/// [`roots`] given `f = o − c` and `cterm = f·f − r²` (worked out once for rays that
+/// share an origin; the same values, so the same roots).
+#[inline]
+pub fn roots_from<V: Vector>(f: V, cterm: V::R, d: V, r: V::R) -> Option<Roots<V>> {
     let bp = -f.dot(d);
     let l = f + d * bp;
     let disc = r * r - l.dot(l);
@@ -47,7 +54,6 @@ pub fn roots<V: Vector>(o: V, d: V, c: V, r: V::R) -> Option<Roots<V>> {
     } else {
         bp - half_chord
     };
-    let cterm = f.dot(f) - r * r;
     let (t0, t1) = if q == V::R::ZERO {
         (V::R::ZERO, V::R::ZERO)
     } else {
