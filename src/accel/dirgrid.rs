@@ -13,6 +13,8 @@ pub struct DirGrid {
     pub centre: DVec3,
     /// Cells per face side.
     n: u32,
+    /// `n/2`.
+    half_n: f32,
     /// Cell `c` lists `items[offsets[c]..offsets[c+1]]`.
     offsets: Vec<u32>,
     /// Per entry: the sphere, and its nearest distance from the centre rounded down.
@@ -97,6 +99,7 @@ impl DirGrid {
         DirGrid {
             centre,
             n,
+            half_n: 0.5 * n as f32,
             offsets,
             items,
             always,
@@ -115,7 +118,7 @@ impl DirGrid {
             (4 + u32::from(d.z < 0.0), a.z, d.x, d.y)
         };
         // (x/major + 1)·n/2 with one division.
-        let half_n = 0.5 * self.n as f32;
+        let half_n = self.half_n;
         let scale = half_n / major;
         let to_cell = |x: f32| ((x * scale + half_n) as u32).min(self.n - 1);
         cell_index(face, to_cell(u), to_cell(v), self.n)

@@ -89,9 +89,18 @@ fn grid_resolution(spheres: usize) -> u32 {
 pub struct PointGrid {
     grid: DirGrid,
     quick: Vec<PointQuick>,
-    /// Around the eye only: per sphere, `eye − centre` and `|eye − centre|² − r²` in
-    /// `f64`, the origin's part of the exact test.
-    exact: Vec<(DVec3, f64)>,
+    /// Around the eye only: per sphere, all that a primary ray's tests read of it.
+    exact: Vec<EyeSphere>,
+}
+
+/// A sphere as primary rays test it: the quick test's constants and the origin's part
+/// of the exact test (`eye − centre` and `|eye − centre|² − r²` in `f64`), side by side.
+#[derive(Clone, Copy)]
+struct EyeSphere {
+    quick: PointQuick,
+    f: DVec3,
+    cterm: f64,
+    radius: f64,
 }
 
 /// The grid around a camera origin (see [`Spheres::eye_grid`]).
@@ -322,19 +331,22 @@ impl Spheres {
     /// `grid` around the eye: [`Spheres::point_grid`] with the exact test's constants.
     fn eye_point_grid(&self, grid: DirGrid) -> EyeGrid {
         let eye = grid.centre;
-        let exact = self
-            .center
+        let point = self.point_grid(grid);
+        let exact = point
+            .quick
             .iter()
-            .zip(&self.radius)
-            .map(|(&c, &r)| {
+            .zip(self.center.iter().zip(&self.radius))
+            .map(|(&quick, (&c, &radius))| {
                 let f = eye - c;
-                (f, f.dot(f) - r * r)
+                EyeSphere {
+                    quick,
+                    f,
+                    cterm: f.dot(f) - radius * radius,
+                    radius,
+                }
             })
             .collect();
-        PointGrid {
-            exact,
-            ..self.point_grid(grid)
-        }
+        PointGrid { exact, ..point }
     }
 
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
@@ -491,13 +503,13 @@ impl Spheres {
                 break; // the rest are all farther
             }
             let k = k as usize;
-            if !eye.quick[k].may_cross(d, t_max) {
+            let sphere = &eye.exact[k];
+            if !sphere.quick.may_cross(d, t_max) {
                 continue;
             }
             let d64 = *d64.get_or_insert_with(|| d.as_dvec3().normalize());
-            let (f, cterm) = eye.exact[k];
-            let r = self.radius[k];
-            let Some(rt) = roots_from(f, cterm, d64, r) else {
+            let r = sphere.radius;
+            let Some(rt) = roots_from(sphere.f, sphere.cterm, d64, r) else {
                 continue;
             };
             // `crossing` for a ray with no spawn sphere and `t_min = 0`.
