@@ -233,6 +233,36 @@ where
     T: Send,
     F: Fn(u32, u32, &mut [T], &mut RayCounts) + Sync,
 {
+    for_each_row(
+        opts,
+        area,
+        states,
+        per_pixel,
+        samples,
+        control,
+        |j, row, counts| {
+            for (a, state) in row.chunks_mut(per_pixel).enumerate() {
+                pixel(area.x + a as u32, j, state, counts);
+            }
+        },
+    )
+}
+
+/// Runs `row(j, states, counts)` for every row of `area` (`j` from the bottom of the
+/// image) with the states of its pixels; see [`for_each_pixel`].
+fn for_each_row<T, F>(
+    opts: &RenderOptions,
+    area: Region,
+    states: &mut [T],
+    per_pixel: usize,
+    samples: u64,
+    control: &RenderControl,
+    row: F,
+) -> Result<RayCounts, RenderError>
+where
+    T: Send,
+    F: Fn(u32, &mut [T], &mut RayCounts) + Sync,
+{
     let aw = area.width as usize;
     assert_eq!(
         states.len(),
@@ -248,14 +278,12 @@ where
             .enumerate()
             .map(|(band, rows)| {
                 let mut counts = RayCounts::default();
-                for (r, row) in rows.chunks_mut(row_len).enumerate() {
+                for (r, states) in rows.chunks_mut(row_len).enumerate() {
                     if control.is_cancelled() {
                         return Err(RenderError::Cancelled);
                     }
                     let j = j0 + (band * BAND_ROWS + r) as u32;
-                    for (a, state) in row.chunks_mut(per_pixel).enumerate() {
-                        pixel(area.x + a as u32, j, state, &mut counts);
-                    }
+                    row(j, states, &mut counts);
                     control
                         .pixels_done
                         .fetch_add(aw as u64 * samples, Ordering::Relaxed);
@@ -438,28 +466,36 @@ fn render_with<T: SampleTracer>(
             let centres: Vec<f32> = (area.x..area.x + area.width)
                 .map(|i| (i as f32 + 0.5) / opts.image.width as f32)
                 .collect();
-            let rays = for_each_pixel(
+            let rays = for_each_row(
                 opts,
                 area,
                 &mut pixels,
                 1,
                 u64::from(spp),
                 control,
-                |i, j, p, counts| {
+                |j, row, counts| {
                     if spp == 1 {
-                        // The pixel centre: `film` for one sample, with the columns'
-                        // positions worked out once (same values, no division).
+                        // The pixel centres: `film` for one sample, with the columns'
+                        // positions worked out once (same values, no division), and
+                        // the row at once, which lets the tracer share work.
                         let t = (j as f32 + 0.5) / opts.image.height as f32;
-                        let c = tracer.sample(centres[(i - area.x) as usize], t, counts);
-                        p[0] = if c.is_finite() { c } else { Vec3::ZERO };
+                        tracer.sample_row(&centres, t, row, counts);
+                        for p in row.iter_mut() {
+                            if !p.is_finite() {
+                                *p = Vec3::ZERO;
+                            }
+                        }
                         return;
                     }
-                    let mut sum = Vec3::ZERO;
-                    for k in 0..spp {
-                        let (s, t) = film(opts, i, j, k);
-                        sum += tracer.sample(s, t, counts);
+                    for (a, p) in row.iter_mut().enumerate() {
+                        let i = area.x + a as u32;
+                        let mut sum = Vec3::ZERO;
+                        for k in 0..spp {
+                            let (s, t) = film(opts, i, j, k);
+                            sum += tracer.sample(s, t, counts);
+                        }
+                        *p = pixel_value(sum, spp);
                     }
-                    p[0] = pixel_value(sum, spp);
                 },
             )?;
             Ok((frame(pixels), vec![0.0; n], n as u64, rays))

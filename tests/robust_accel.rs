@@ -208,3 +208,55 @@ fn culling_never_loses_a_hit_or_an_occluder() {
         "{c:?}"
     );
 }
+
+/// The tracer's sky runs: when `eye_sees_nothing_between` says a row of directions sees
+/// only sky, every direction between (as a row of pixels computes them) misses every
+/// sphere, by brute force in `f64`, and the eye query agrees.
+#[test]
+fn sky_runs_see_no_sphere() {
+    let counts = RefCell::new((0u64, 0u64)); // (runs said empty, directions checked)
+    let runs = prop::collection::vec((unit_vector(), unit_vector(), 0.0f64..0.008), 32);
+    runner(200)
+        .run(
+            &(world(), log_uniform(-1.0, 4.0), unit_vector(), runs),
+            |(spheres, eye_dist, eye_dir, runs)| {
+                // Few spheres, so that empty cells are common.
+                let spheres = &spheres[..spheres.len().min(12)];
+                let eye = eye_dir * eye_dist;
+                let set = Spheres::new(spheres);
+                let grid = set.eye_grid(eye);
+                let mut c = counts.borrow_mut();
+                for &(base, across, span) in &runs {
+                    // A row: corner + s·h with s in [0, 1], as the camera forms it.
+                    let h = across.cross(base).normalize_or(across) * span;
+                    let (corner, h) = (base.as_vec3(), h.as_vec3());
+                    let dir = |s: f32| (corner + h * s).normalize();
+                    if !set.eye_sees_nothing_between(&grid, dir(0.0), dir(1.0)) {
+                        continue;
+                    }
+                    c.0 += 1;
+                    for step in 0..=16 {
+                        let d = dir(step as f32 / 16.0);
+                        c.1 += 1;
+                        let q = Query {
+                            origin: eye,
+                            dir: d,
+                            from: None,
+                        };
+                        let (o, d64) = query_ray(&q);
+                        let hits: Vec<_> = crossings(o, d64, spheres, None, 0.0)
+                            .into_iter()
+                            .filter(|x| !x.3)
+                            .collect();
+                        prop_assert!(hits.is_empty(), "a sky run hits {hits:?}");
+                        prop_assert!(set.closest_from_eye(&grid, d).is_none());
+                    }
+                }
+                Ok(())
+            },
+        )
+        .unwrap_or_else(|e| panic!("{e}\n{:?}", counts.borrow()));
+    let (empty, checked) = counts.into_inner();
+    println!("sky runs: {empty} said empty, {checked} directions checked");
+    assert!(empty > 500, "too few empty runs to say anything: {empty}");
+}

@@ -531,6 +531,18 @@ impl Spheres {
         self.finish(best)
     }
 
+    /// `true` when no ray from the eye with a direction between `a` and `b` (unit
+    /// vectors; the directions of one image row between two pixels, say) can meet a
+    /// sphere. So when `a` and `b` fall in one empty cell of the eye grid: a cell is a
+    /// square in its face's plane, the rows' directions between project to the segment
+    /// between, inside it; and cells list every sphere seen within a widened cone,
+    /// which covers the rounding of the directions many times over.
+    pub fn eye_sees_nothing_between(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> bool {
+        let grid = &eye.grid;
+        let cell = grid.cell(a);
+        grid.always.is_empty() && cell == grid.cell(b) && grid.candidates(cell).is_empty()
+    }
+
     /// Lowers `factor` by sphere `k`'s occlusion of the shadow segment.
     #[inline(always)]
     fn occlude(&self, k: u32, ray: &Ray, dist: f64, factor: &mut f32) {

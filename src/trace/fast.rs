@@ -231,6 +231,33 @@ impl SampleTracer for FastTracer {
         self.sample_bounded(s, t, counts).0
     }
 
+    fn sample_row(&self, s: &[f32], t: f32, out: &mut [Vec3], counts: &mut RayCounts) {
+        let dir =
+            |s: f32| model::primary_direction(self.corner, self.horizontal, self.vertical, s, t);
+        // Runs of a few samples whose end directions fall in one empty cell of the eye
+        // grid see only sky (`Spheres::eye_sees_nothing_between`): their colours are
+        // the sky's, as `trace` would return them, without the per-ray query.
+        const RUN: usize = 8;
+        for (s, out) in s.chunks(RUN).zip(out.chunks_mut(RUN)) {
+            let (first, last) = (dir(s[0]), dir(s[s.len() - 1]));
+            if self.max_depth > 0
+                && self
+                    .compiled
+                    .spheres
+                    .eye_sees_nothing_between(&self.eye, first, last)
+            {
+                for (o, &s) in out.iter_mut().zip(s) {
+                    *o = model::sky(dir(s), self.compiled.sky_down, self.compiled.sky_up);
+                }
+                counts.primary += s.len() as u64;
+            } else {
+                for (o, &s) in out.iter_mut().zip(s) {
+                    *o = self.sample(s, t, counts);
+                }
+            }
+        }
+    }
+
     fn sample_bounded(&self, s: f32, t: f32, counts: &mut RayCounts) -> (Vec3, f32) {
         let dir = model::primary_direction(self.corner, self.horizontal, self.vertical, s, t);
         let ray = Query {

@@ -38,4 +38,12 @@ pub trait SampleTracer: Sync {
     fn sample_bounded(&self, s: f32, t: f32, counts: &mut RayCounts) -> (Vec3, f32) {
         (self.sample(s, t, counts), 0.0)
     }
+
+    /// `out[i] = sample(s[i], t)`: a row of samples at one height, the same colours
+    /// as one by one (a tracer may share work between neighbours).
+    fn sample_row(&self, s: &[f32], t: f32, out: &mut [Vec3], counts: &mut RayCounts) {
+        for (o, &s) in out.iter_mut().zip(s) {
+            *o = self.sample(s, t, counts);
+        }
+    }
 }
