@@ -71,7 +71,8 @@ const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
 /// Depth after which splits are by count: keeps any tree below `STACK` levels.
 const MAX_SAH_DEPTH: u32 = 48;
-const STACK: usize = 256;
+/// Four entries a level (children of every node on the path) and then some.
+const STACK: usize = 320;
 
 impl Bvh {
     /// Builds over `boxes` (one per item): a binary binned-SAH tree, then collapsed.
@@ -125,14 +126,24 @@ impl Bvh {
         let inv = [finite(inv_d.x), finite(inv_d.y), finite(inv_d.z)];
         let o4 = [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)];
         let inv4 = inv.map(f32x4::splat);
-        // Not zeroed: a zeroed 2 KiB array cost more than the traversal of a short ray.
-        let mut stack: ArrayVec<(u32, f32), STACK> = ArrayVec::new();
-        stack.push((0, 0.0));
-        while let Some((node, t_enter)) = stack.pop() {
+        // Entries: (node, 0) or (first item, items) of a leaf, with the distance at
+        // which the ray enters its box. Not zeroed: a zeroed array cost more than the
+        // traversal of a short ray.
+        let mut stack: ArrayVec<(u32, u32, f32), STACK> = ArrayVec::new();
+        stack.push((0, 0, 0.0));
+        while let Some((index, count, t_enter)) = stack.pop() {
             if t_enter > t_max {
                 continue;
             }
-            let n = &self.nodes[node as usize];
+            if count > 0 {
+                for slot in index..index + count {
+                    if let Some(t) = visit(slot) {
+                        t_max = t_max.min(t);
+                    }
+                }
+                continue;
+            }
+            let n = &self.nodes[index as usize];
             let mut near = f32x4::splat(0.0);
             let mut far = f32x4::splat(t_max);
             // No NaN can arise (finite reciprocals, never 0; boxes finite or empty,
@@ -149,7 +160,10 @@ impl Bvh {
                 continue;
             }
             let near = near.to_array();
-            // Leaves now, nearest first; inner children onto the stack, farthest first.
+            // Children onto the stack farthest first, leaves and inner nodes alike: the
+            // nearest comes off first, so hits are found nearest first and prune the
+            // rest (visiting leaves at once found farther hits first, each a wasted
+            // exact test).
             let mut order = [0usize; 4];
             let mut k = 0;
             for lane in 0..4 {
@@ -159,29 +173,17 @@ impl Bvh {
                 }
             }
             let order = &mut order[..k];
-            // Insertion sort by entry distance: at most four lanes (a library sort is
-            // not inlined and costs more than the node test).
+            // Insertion sort, farthest first: at most four lanes (a library sort is not
+            // inlined and costs more than the node test).
             for a in 1..k {
                 let mut b = a;
-                while b > 0 && near[order[b - 1]] > near[order[b]] {
+                while b > 0 && near[order[b - 1]] < near[order[b]] {
                     order.swap(b - 1, b);
                     b -= 1;
                 }
             }
             for &lane in order.iter() {
-                if n.count[lane] > 0 && near[lane] <= t_max {
-                    let first = n.child[lane];
-                    for slot in first..first + n.count[lane] {
-                        if let Some(t) = visit(slot) {
-                            t_max = t_max.min(t);
-                        }
-                    }
-                }
-            }
-            for &lane in order.iter().rev() {
-                if n.count[lane] == 0 {
-                    stack.push((n.child[lane], near[lane]));
-                }
+                stack.push((n.child[lane], n.count[lane], near[lane]));
             }
         }
     }
