@@ -618,11 +618,14 @@ fn may_cross(c: DVec3, w: f32, ray: &Ray, t_max: f32) -> bool {
     let rr = w * w;
     let ff = f.dot(f);
     let slack = QUICK_SLACK * (rr + ff);
-    if l.dot(l) > rr + slack {
+    let ll = l.dot(l);
+    if ll > rr + slack {
         return false;
     }
-    // The crossings lie in [bp − r, bp + r], up to rounding.
-    let reach = w + QUICK_SLACK * (ff.sqrt() + w);
+    // The crossings lie in [bp − h, bp + h] with h the half chord, up to rounding; the
+    // slack keeps this h above the true one. (With h = r, a ray leaving a huge sphere's
+    // outside — up from the ground — passed and cost an exact test.)
+    let reach = (rr + slack - ll).sqrt() + QUICK_SLACK * (ff.sqrt() + w);
     bp + reach > 0.0 && bp - reach < t_max
 }
 
