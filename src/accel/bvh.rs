@@ -164,13 +164,34 @@ impl Bvh {
             // nearest comes off first, so hits are found nearest first and prune the
             // rest (visiting leaves at once found farther hits first, each a wasted
             // exact test).
-            let mut order = [0usize; 4];
-            let mut k = 0;
-            for lane in 0..4 {
-                if hit & (1 << lane) != 0 {
-                    order[k] = lane;
-                    k += 1;
-                }
+            let push = |stack: &mut ArrayVec<_, STACK>, lane: usize| {
+                stack.push((n.child[lane], n.count[lane], near[lane]));
+            };
+            let first = hit.trailing_zeros() as usize;
+            let rest = hit & (hit - 1);
+            if rest == 0 {
+                push(&mut stack, first);
+                continue;
+            }
+            let second = rest.trailing_zeros() as usize;
+            if rest & (rest - 1) == 0 {
+                // Two children, the common case below the top: one comparison.
+                let (far, near_lane) = if near[first] < near[second] {
+                    (second, first)
+                } else {
+                    (first, second)
+                };
+                push(&mut stack, far);
+                push(&mut stack, near_lane);
+                continue;
+            }
+            let mut order = [first, second, 0, 0];
+            let mut k = 2;
+            let mut more = rest & (rest - 1);
+            while more != 0 {
+                order[k] = more.trailing_zeros() as usize;
+                more &= more - 1;
+                k += 1;
             }
             let order = &mut order[..k];
             // Insertion sort, farthest first: at most four lanes (a library sort is not
@@ -183,7 +204,7 @@ impl Bvh {
                 }
             }
             for &lane in order.iter() {
-                stack.push((n.child[lane], n.count[lane], near[lane]));
+                push(&mut stack, lane);
             }
         }
     }
