@@ -101,6 +101,7 @@ struct EyeSphere {
     f: DVec3,
     cterm: f64,
     radius: f64,
+    inv_radius: f64,
 }
 
 /// The grid around a camera origin (see [`Spheres::eye_grid`]).
@@ -186,6 +187,8 @@ struct LeafSphere {
 pub struct Spheres {
     center: Vec<DVec3>,
     radius: Vec<f64>,
+    /// `1/radius`, for the normals.
+    inv_radius: Vec<f64>,
     /// `f32` centre and radius, the radius widened to cover the centre's rounding.
     quick: Vec<Vec4>,
     bvh: Bvh,
@@ -248,6 +251,7 @@ impl Spheres {
         Spheres {
             bvh,
             leaf,
+            inv_radius: radius.iter().map(|r| 1.0 / r).collect(),
             center,
             radius,
             quick,
@@ -343,6 +347,7 @@ impl Spheres {
                     f,
                     cterm: f.dot(f) - radius * radius,
                     radius,
+                    inv_radius: 1.0 / radius,
                 }
             })
             .collect();
@@ -380,7 +385,7 @@ impl Spheres {
         // spheres that pass the quick test, not for every ray (caching it per ray
         // measured 3.8% more instructions on hw3).
         let (o, d, t_min) = (ray.o64, ray.d32.as_dvec3().normalize(), ray.t_min);
-        let (c, r) = (self.center[k], self.radius[k]);
+        let (c, r, inv_r) = (self.center[k], self.radius[k], self.inv_radius[k]);
         let own = ray
             .from
             .filter(|&(s, _)| s as usize == k)
@@ -390,12 +395,13 @@ impl Spheres {
         }
         let rt = roots(o, d, c, r)?;
         if own == Some(Side::Inward) {
-            return (rt.far > 0.0 && rt.far < t_max).then(|| (rt.far, false, rt.normal_far(d, r)));
+            return (rt.far > 0.0 && rt.far < t_max)
+                .then(|| (rt.far, false, rt.normal_far_scaled(d, inv_r)));
         }
         if rt.near > t_min && rt.near < t_max {
-            Some((rt.near, true, rt.normal_near(d, r)))
+            Some((rt.near, true, rt.normal_near_scaled(d, inv_r)))
         } else if rt.far > t_min && rt.far < t_max {
-            Some((rt.far, false, rt.normal_far(d, r)))
+            Some((rt.far, false, rt.normal_far_scaled(d, inv_r)))
         } else {
             None
         }
@@ -513,10 +519,11 @@ impl Spheres {
                 continue;
             };
             // `crossing` for a ray with no spawn sphere and `t_min = 0`.
+            let inv_r = sphere.inv_radius;
             let (t, entering, normal) = if rt.near > 0.0 && rt.near < best.t {
-                (rt.near, true, rt.normal_near(d64, r))
+                (rt.near, true, rt.normal_near_scaled(d64, inv_r))
             } else if rt.far > 0.0 && rt.far < best.t {
-                (rt.far, false, rt.normal_far(d64, r))
+                (rt.far, false, rt.normal_far_scaled(d64, inv_r))
             } else {
                 continue;
             };

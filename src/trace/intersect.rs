@@ -20,13 +20,26 @@ impl<V: Vector> Roots<V> {
     /// Outward unit normal at the near root: `(l − half_chord·d)/r`, no cancellation.
     #[inline]
     pub fn normal_near(&self, d: V, radius: V::R) -> V {
-        (self.closest - d * self.half_chord) * (V::R::ONE / radius)
+        self.normal_near_scaled(d, V::R::ONE / radius)
     }
 
     /// Outward unit normal at the far root.
     #[inline]
     pub fn normal_far(&self, d: V, radius: V::R) -> V {
-        (self.closest + d * self.half_chord) * (V::R::ONE / radius)
+        self.normal_far_scaled(d, V::R::ONE / radius)
+    }
+
+    /// [`Roots::normal_near`] given `1/r` worked out beforehand: the same value, without
+    /// a division at the end of the hit's critical path.
+    #[inline]
+    pub fn normal_near_scaled(&self, d: V, inv_radius: V::R) -> V {
+        (self.closest - d * self.half_chord) * inv_radius
+    }
+
+    /// [`Roots::normal_far`] given `1/r`.
+    #[inline]
+    pub fn normal_far_scaled(&self, d: V, inv_radius: V::R) -> V {
+        (self.closest + d * self.half_chord) * inv_radius
     }
 }
 
