@@ -502,8 +502,9 @@ impl Spheres {
         }
         let mut best = Best::NONE;
         let mut t_max = f32::INFINITY;
-        // As in `crossing`: the direction renormalised in `f64`, once.
-        let mut d64 = None;
+        // As in `crossing`: the direction renormalised in `f64`, once, first: its square
+        // root and division then run while the grid is read, off the hit's critical path.
+        let d64 = d.as_dvec3().normalize();
         for &(k, near) in grid.candidates(grid.cell(d)) {
             if near >= t_max {
                 break; // the rest are all farther
@@ -513,7 +514,6 @@ impl Spheres {
             if !sphere.quick.may_cross(d, t_max) {
                 continue;
             }
-            let d64 = *d64.get_or_insert_with(|| d.as_dvec3().normalize());
             let r = sphere.radius;
             let Some(rt) = roots_from(sphere.f, sphere.cterm, d64, r) else {
                 continue;
