@@ -93,6 +93,41 @@ pub struct PointGrid {
     exact: Vec<EyeSphere>,
 }
 
+impl PointGrid {
+    /// Whether [`Spheres::closest_from_eye`] may use its shortcut: an eye grid, and the
+    /// eye inside no sphere (else the general query runs).
+    fn from_eye_applies(&self) -> bool {
+        self.grid.always.is_empty() && !self.exact.is_empty()
+    }
+
+    fn query(&self, d: Vec3) -> Query {
+        Query {
+            origin: self.grid.centre,
+            dir: d,
+            from: None,
+        }
+    }
+}
+
+/// What a primary ray needs before its candidates are tested.
+struct EyeStart<'a> {
+    /// As in `crossing`: the direction renormalised in `f64`, once, first: its square
+    /// root and division then run while the grid is read, off the hit's critical path.
+    d64: DVec3,
+    /// The spheres of its cell, nearest first.
+    candidates: &'a [(u32, f32)],
+}
+
+impl<'a> EyeStart<'a> {
+    #[inline(always)]
+    fn new(eye: &'a EyeGrid, d: Vec3) -> Self {
+        EyeStart {
+            d64: d.as_dvec3().normalize(),
+            candidates: eye.grid.candidates(eye.grid.cell(d)),
+        }
+    }
+}
+
 /// A sphere as primary rays test it: the quick test's constants and the origin's part
 /// of the exact test (`eye − centre` and `|eye − centre|² − r²` in `f64`), side by side.
 #[derive(Clone, Copy)]
@@ -490,22 +525,36 @@ impl Spheres {
     /// [`Spheres::closest_primary`] for the ray from the eye with unit direction `d`,
     /// with the origin's part of every test worked out beforehand (same results).
     pub fn closest_from_eye(&self, eye: &EyeGrid, d: Vec3) -> Option<Hit> {
-        let grid = &eye.grid;
-        if !grid.always.is_empty() || eye.exact.is_empty() {
-            // The eye inside a sphere (rare): the general query.
-            let q = Query {
-                origin: grid.centre,
-                dir: d,
-                from: None,
-            };
-            return self.closest_primary(eye, &q);
+        if !eye.from_eye_applies() {
+            return self.closest_primary(eye, &eye.query(d));
         }
+        let start = EyeStart::new(eye, d);
+        self.closest_from_start(eye, d, start)
+    }
+
+    /// [`Spheres::closest_from_eye`] of two rays at once: each ray's answer is a chain
+    /// of long-latency steps (square roots, divisions, dependent loads); set side by
+    /// side, the processor overlaps the two chains.
+    pub fn closest_from_eye_pair(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> [Option<Hit>; 2] {
+        if !eye.from_eye_applies() {
+            return [
+                self.closest_primary(eye, &eye.query(a)),
+                self.closest_primary(eye, &eye.query(b)),
+            ];
+        }
+        let (start_a, start_b) = (EyeStart::new(eye, a), EyeStart::new(eye, b));
+        [
+            self.closest_from_start(eye, a, start_a),
+            self.closest_from_start(eye, b, start_b),
+        ]
+    }
+
+    #[inline(always)]
+    fn closest_from_start(&self, eye: &EyeGrid, d: Vec3, start: EyeStart<'_>) -> Option<Hit> {
+        let d64 = start.d64;
         let mut best = Best::NONE;
         let mut t_max = f32::INFINITY;
-        // As in `crossing`: the direction renormalised in `f64`, once, first: its square
-        // root and division then run while the grid is read, off the hit's critical path.
-        let d64 = d.as_dvec3().normalize();
-        for &(k, near) in grid.candidates(grid.cell(d)) {
+        for &(k, near) in start.candidates {
             if near >= t_max {
                 break; // the rest are all farther
             }

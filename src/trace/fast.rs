@@ -7,7 +7,7 @@ use std::sync::Arc;
 use glam::{DVec3, Vec3};
 
 use super::{RayCounts, SampleTracer};
-use crate::accel::{EyeGrid, Query, Spheres};
+use crate::accel::{EyeGrid, Hit, Query, Spheres};
 use crate::camera::Camera;
 use crate::model::{self, Branches, Side};
 use crate::scene::Scene;
@@ -157,8 +157,22 @@ impl FastTracer {
         } else {
             self.compiled.spheres.closest(ray)
         };
+        self.shade(ray.dir, hit, depth, weight, counts, skipped)
+    }
+
+    /// The colour seen along direction `dir` when its ray's closest hit is `hit` (the
+    /// part of `trace` after the query).
+    fn shade(
+        &self,
+        dir: Vec3,
+        hit: Option<Hit>,
+        depth: u32,
+        weight: f32,
+        counts: &mut RayCounts,
+        skipped: &mut Skipped,
+    ) -> Vec3 {
         let Some(hit) = hit else {
-            return model::sky(ray.dir, self.compiled.sky_down, self.compiled.sky_up);
+            return model::sky(dir, self.compiled.sky_down, self.compiled.sky_up);
         };
         let m = &self.compiled.materials[hit.sphere as usize];
         let front = hit.entering;
@@ -196,14 +210,14 @@ impl FastTracer {
         }
         let w_reflect = weight * (1.0 - m.w_t) * m.w_r;
         let reflected = if m.branches.reflect && self.keep(w_reflect, skipped) {
-            let dir = model::reflect(ray.dir, n).normalize();
+            let dir = model::reflect(dir, n).normalize();
             self.trace(&spawn(dir, !front), depth + 1, w_reflect, counts, skipped)
         } else {
             Vec3::ZERO
         };
         let w_transmit = weight * m.w_t;
         let transmitted = if m.branches.transmit && self.keep(w_transmit, skipped) {
-            let (dir, crosses) = model::transmit(ray.dir, n, front, m.ior);
+            let (dir, crosses) = model::transmit(dir, n, front, m.ior);
             self.trace(
                 &spawn(dir, front == crosses),
                 depth + 1,
@@ -250,6 +264,21 @@ impl SampleTracer for FastTracer {
                     *o = model::sky(dir(s), self.compiled.sky_down, self.compiled.sky_up);
                 }
                 counts.primary += s.len() as u64;
+            } else if self.max_depth > 0 && self.cutoff == 0.0 {
+                // Two rays at a time through the eye query (see
+                // `Spheres::closest_from_eye_pair`), then shaded one by one, as `trace`.
+                let spheres = &self.compiled.spheres;
+                let mut skipped = Skipped::default();
+                for (o, s) in out.chunks_mut(2).zip(s.chunks(2)) {
+                    let (a, b) = (dir(s[0]), dir(s[s.len() - 1]));
+                    let [hit_a, hit_b] = spheres.closest_from_eye_pair(&self.eye, a, b);
+                    counts.primary += 1;
+                    o[0] = self.shade(a, hit_a, 0, 1.0, counts, &mut skipped);
+                    if o.len() == 2 {
+                        counts.primary += 1;
+                        o[1] = self.shade(b, hit_b, 0, 1.0, counts, &mut skipped);
+                    }
+                }
             } else {
                 for (o, &s) in out.iter_mut().zip(s) {
                     *o = self.sample(s, t, counts);
