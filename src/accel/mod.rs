@@ -96,7 +96,7 @@ pub struct PointGrid {
 impl PointGrid {
     /// Whether [`Spheres::closest_from_eye`] may use its shortcut: an eye grid, and the
     /// eye inside no sphere (else the general query runs).
-    fn from_eye_applies(&self) -> bool {
+    fn eye_shortcut_applies(&self) -> bool {
         self.grid.always.is_empty() && !self.exact.is_empty()
     }
 
@@ -525,7 +525,7 @@ impl Spheres {
     /// [`Spheres::closest_primary`] for the ray from the eye with unit direction `d`,
     /// with the origin's part of every test worked out beforehand (same results).
     pub fn closest_from_eye(&self, eye: &EyeGrid, d: Vec3) -> Option<Hit> {
-        if !eye.from_eye_applies() {
+        if !eye.eye_shortcut_applies() {
             return self.closest_primary(eye, &eye.query(d));
         }
         let start = EyeStart::new(eye, d);
@@ -536,7 +536,7 @@ impl Spheres {
     /// of long-latency steps (square roots, divisions, dependent loads); set side by
     /// side, the processor overlaps the two chains.
     pub fn closest_from_eye_pair(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> [Option<Hit>; 2] {
-        if !eye.from_eye_applies() {
+        if !eye.eye_shortcut_applies() {
             return [
                 self.closest_primary(eye, &eye.query(a)),
                 self.closest_primary(eye, &eye.query(b)),
