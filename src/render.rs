@@ -329,6 +329,19 @@ fn thread_pool(n: usize) -> Result<Arc<rayon::ThreadPool>, RenderError> {
     Ok(pool)
 }
 
+/// The film abscissae of the centres of the area's columns: `film`'s `s` for one
+/// sample a pixel (the same values), worked out once.
+fn pixel_centres(opts: &RenderOptions, area: Region) -> Vec<f32> {
+    (area.x..area.x + area.width)
+        .map(|i| (i as f32 + 0.5) / opts.image.width as f32)
+        .collect()
+}
+
+/// `film`'s `t` for one sample a pixel in row `j`.
+fn centre_height(opts: &RenderOptions, j: u32) -> f32 {
+    (j as f32 + 0.5) / opts.image.height as f32
+}
+
 /// The film position of sample `k` of pixel `(i, j)`.
 #[inline]
 fn film(opts: &RenderOptions, i: u32, j: u32, k: u32) -> (f32, f32) {
@@ -349,21 +362,25 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
     sums: &mut [Vec3],
     control: &RenderControl,
 ) -> Result<RayCounts, RenderError> {
-    let n = samples.len() as u64;
-    for_each_pixel(
-        opts,
-        opts.area(),
-        sums,
-        1,
-        n,
-        control,
-        |i, j, sum, counts| {
-            for k in samples.clone() {
-                let (s, t) = film(opts, i, j, k);
-                sum[0] += tracer.sample(s, t, counts);
+    let area = opts.area();
+    if opts.image.spp == 1 && samples == (0..1) {
+        // One sample a pixel, at its centre: whole rows at once, as `render` does.
+        let centres = pixel_centres(opts, area);
+        return for_each_row(opts, area, sums, 1, 1, control, |j, row, counts| {
+            let mut colours = vec![Vec3::ZERO; row.len()];
+            tracer.sample_row(&centres, centre_height(opts, j), &mut colours, counts);
+            for (sum, c) in row.iter_mut().zip(colours) {
+                *sum += c;
             }
-        },
-    )
+        });
+    }
+    let n = samples.len() as u64;
+    for_each_pixel(opts, area, sums, 1, n, control, |i, j, sum, counts| {
+        for k in samples.clone() {
+            let (s, t) = film(opts, i, j, k);
+            sum[0] += tracer.sample(s, t, counts);
+        }
+    })
 }
 
 /// Divides sums of `samples` samples into pixel values; anything non-finite becomes 0
@@ -463,9 +480,7 @@ fn render_with<T: SampleTracer>(
             let mut pixels: Vec<Vec3> = in_pool(opts, || {
                 (0..n).into_par_iter().map(|_| Vec3::ZERO).collect()
             })?;
-            let centres: Vec<f32> = (area.x..area.x + area.width)
-                .map(|i| (i as f32 + 0.5) / opts.image.width as f32)
-                .collect();
+            let centres = pixel_centres(opts, area);
             let rays = for_each_row(
                 opts,
                 area,
@@ -478,8 +493,7 @@ fn render_with<T: SampleTracer>(
                         // The pixel centres: `film` for one sample, with the columns'
                         // positions worked out once (same values, no division), and
                         // the row at once, which lets the tracer share work.
-                        let t = (j as f32 + 0.5) / opts.image.height as f32;
-                        tracer.sample_row(&centres, t, row, counts);
+                        tracer.sample_row(&centres, centre_height(opts, j), row, counts);
                         for p in row.iter_mut() {
                             if !p.is_finite() {
                                 *p = Vec3::ZERO;
