@@ -269,6 +269,26 @@ fn bytes_are_rounded_and_clamped_linear_values() {
 }
 
 #[test]
+fn bytes_round_every_value_as_round_does() {
+    // Every f32 in [0, 1] whose bits are a multiple of 7 (about 150 million values),
+    // and the halfway points k + 0.5 and their neighbours: the same byte as
+    // `(c·255).round()` (half away from zero).
+    let check = |c: f32| {
+        let want = (c.clamp(0.0, 1.0) * 255.0).round() as u8;
+        assert_eq!(image_io::to_byte(c), want, "c = {c:e} ({:#x})", c.to_bits());
+    };
+    for bits in (0..=1.0f32.to_bits()).step_by(7) {
+        check(f32::from_bits(bits));
+    }
+    for k in 0..255 {
+        let half = (k as f32 + 0.5) / 255.0;
+        for c in [half.next_down(), half, half.next_up()] {
+            check(c);
+        }
+    }
+}
+
+#[test]
 fn the_committed_readme_image_is_the_hw3_render() {
     // assets/hw3.png (shown in README.md) is `whitted render -o assets/hw3.png`. Speed
     // work may move a pixel by a level on an edge; anything more means it is stale.
