@@ -635,31 +635,82 @@ impl Spheres {
         let Some(lg) = self.lights.get(light) else {
             return self.shadow(q, dist);
         };
-        let grid = &lg.grid;
-        let ray = Ray::new(q);
+        let start = ShadowStart::new(lg, q, dist);
+        self.shadow_from_start(lg, &start)
+    }
+
+    /// [`Spheres::shadow_to_light`] of two segments at once (see
+    /// [`Spheres::closest_from_eye_pair`]).
+    pub fn shadow_to_light_pair(
+        &self,
+        a: (&Query, f64),
+        b: (&Query, f64),
+        light: usize,
+    ) -> [f32; 2] {
+        let Some(lg) = self.lights.get(light) else {
+            return [self.shadow(a.0, a.1), self.shadow(b.0, b.1)];
+        };
+        let (start_a, start_b) = (
+            ShadowStart::new(lg, a.0, a.1),
+            ShadowStart::new(lg, b.0, b.1),
+        );
+        [
+            self.shadow_from_start(lg, &start_a),
+            self.shadow_from_start(lg, &start_b),
+        ]
+    }
+
+    #[inline(always)]
+    fn shadow_from_start(&self, lg: &PointGrid, start: &ShadowStart<'_>) -> f32 {
+        let (ray, dist) = (&start.ray, start.dist);
         let mut factor = 1.0f32;
-        for &k in &grid.always {
-            self.occlude(k, &ray, dist, &mut factor);
+        for &k in &lg.grid.always {
+            self.occlude(k, ray, dist, &mut factor);
         }
-        // The quick test runs from the light, back along the segment: the line through
-        // the light with the (rounded) direction passes within this of the segment's
-        // start (the direction is off by at most ~1.5e-7 radians).
-        let offset = (4e-7 * dist) as f32;
-        let (back, dist32) = (-q.dir, round_up(dist));
-        for &(k, near) in grid.candidates(grid.cell((q.origin - grid.centre).as_vec3())) {
+        for &(k, near) in start.candidates {
             if f64::from(near) >= dist || factor <= 0.0 {
                 break; // beyond the hit point, seen from the light
             }
             if ray.from == Some((k, Side::Outward))
-                || !lg.quick[k as usize].may_cross_near(back, dist32, offset)
+                || !lg.quick[k as usize].may_cross_near(start.back, start.dist32, start.offset)
             {
                 continue;
             }
-            if let Some((_, _, n_k)) = self.crossing(k as usize, &ray, dist) {
+            if let Some((_, _, n_k)) = self.crossing(k as usize, ray, dist) {
                 factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
             }
         }
         factor
+    }
+}
+
+/// What a shadow segment needs before its candidates are tested.
+struct ShadowStart<'a> {
+    ray: Ray,
+    dist: f64,
+    dist32: f32,
+    /// The segment seen from the light.
+    back: Vec3,
+    /// The quick test runs from the light, back along the segment: the line through
+    /// the light with the (rounded) direction passes within this of the segment's
+    /// start (the direction is off by at most ~1.5e-7 radians).
+    offset: f32,
+    /// The spheres of its cell of the light's grid, nearest the light first.
+    candidates: &'a [(u32, f32)],
+}
+
+impl<'a> ShadowStart<'a> {
+    #[inline(always)]
+    fn new(lg: &'a PointGrid, q: &Query, dist: f64) -> Self {
+        let grid = &lg.grid;
+        ShadowStart {
+            ray: Ray::new(q),
+            dist,
+            dist32: round_up(dist),
+            back: -q.dir,
+            offset: (4e-7 * dist) as f32,
+            candidates: grid.candidates(grid.cell((q.origin - grid.centre).as_vec3())),
+        }
     }
 }
 

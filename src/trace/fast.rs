@@ -232,6 +232,59 @@ impl FastTracer {
     }
 }
 
+impl FastTracer {
+    /// Two primary rays' colours, given their hits: `shade` of each, except that when
+    /// both hit diffuse surfaces under a single light, the two are worked out side by
+    /// side and their shadow queries run as a pair (`Spheres::shadow_to_light_pair`),
+    /// so that the two chains of square roots, divisions and loads overlap. The sums
+    /// are `shade`'s, term for term.
+    fn shade_pair(&self, rays: [(Vec3, Option<Hit>); 2], counts: &mut RayCounts) -> [Vec3; 2] {
+        let c = &self.compiled;
+        let diffuse = |hit: Option<Hit>| {
+            let h = hit?;
+            let m = &c.materials[h.sphere as usize];
+            (m.branches.local && !m.branches.reflect && !m.branches.transmit).then_some((h, m))
+        };
+        let (Some((ha, ma)), Some((hb, mb)), [light]) =
+            (diffuse(rays[0].1), diffuse(rays[1].1), c.lights.as_slice())
+        else {
+            let mut skipped = Skipped::default();
+            return rays.map(|(d, hit)| self.shade(d, hit, 0, 1.0, counts, &mut skipped));
+        };
+        // `shade`'s light loop up to the shadow query, for each hit.
+        let towards_light = |h: &Hit| {
+            let n = h.normal.as_vec3();
+            let nf = if h.entering { n } else { -n };
+            let to_light = light.position - h.point;
+            let dist = to_light.length();
+            let l = (to_light * (1.0 / dist)).as_vec3();
+            let q = Query {
+                origin: h.point,
+                dir: l,
+                from: Some((h.sphere, Side::inside(!h.entering))),
+            };
+            (nf.dot(l), q, dist)
+        };
+        let ((cos_a, qa, dist_a), (cos_b, qb, dist_b)) = (towards_light(&ha), towards_light(&hb));
+        let spheres = &c.spheres;
+        let shadows = match (cos_a > 0.0, cos_b > 0.0) {
+            (true, true) => spheres.shadow_to_light_pair((&qa, dist_a), (&qb, dist_b), 0),
+            (true, false) => [spheres.shadow_to_light(&qa, dist_a, 0), 0.0],
+            (false, true) => [0.0, spheres.shadow_to_light(&qb, dist_b, 0)],
+            (false, false) => [0.0, 0.0],
+        };
+        let mut local = |m: &Material, cos: f32, shadow: f32| {
+            if cos > 0.0 {
+                counts.shadow += 1;
+                Vec3::ZERO + model::diffuse(m.color, light.intensity, cos, shadow)
+            } else {
+                Vec3::ZERO
+            }
+        };
+        [local(ma, cos_a, shadows[0]), local(mb, cos_b, shadows[1])]
+    }
+}
+
 /// The largest colour component any trace can return: sky colours and, for local
 /// shading, the sum over lights of the brightest component (kd ≤ 1, cos ≤ 1, s ≤ 1).
 fn value_bound(scene: &Scene) -> f32 {
@@ -272,11 +325,12 @@ impl SampleTracer for FastTracer {
                 for (o, s) in out.chunks_mut(2).zip(s.chunks(2)) {
                     let (a, b) = (dir(s[0]), dir(s[s.len() - 1]));
                     let [hit_a, hit_b] = spheres.closest_from_eye_pair(&self.eye, a, b);
-                    counts.primary += 1;
-                    o[0] = self.shade(a, hit_a, 0, 1.0, counts, &mut skipped);
                     if o.len() == 2 {
+                        counts.primary += 2;
+                        [o[0], o[1]] = self.shade_pair([(a, hit_a), (b, hit_b)], counts);
+                    } else {
                         counts.primary += 1;
-                        o[1] = self.shade(b, hit_b, 0, 1.0, counts, &mut skipped);
+                        o[0] = self.shade(a, hit_a, 0, 1.0, counts, &mut skipped);
                     }
                 }
             } else {
