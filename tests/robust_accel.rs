@@ -184,9 +184,12 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                         .map(|x| (1.0 + sd.dot(x.2)) * 0.5)
                         .fold(1.0f64, f64::min);
                     c.shadowed += u64::from(want < 1.0);
+                    let pair = set.shadow_to_light_pair((&sq, dist), (&sq, dist), 0);
                     for (name, got) in [
                         ("shadow", set.shadow(&sq, dist)),
                         ("shadow_to_light", set.shadow_to_light(&sq, dist, 0)),
+                        ("shadow_to_light_pair, first", pair[0]),
+                        ("shadow_to_light_pair, second", pair[1]),
                     ] {
                         if (f64::from(got) - want).abs() > 1e-5 {
                             c.shadow_wrong += 1;
