@@ -101,16 +101,16 @@ impl Bvh {
         &self.items
     }
 
-    /// Calls `visit(slot)` for every item (`items()[slot]`) whose box the ray `o + t·d`
-    /// (`inv_d = 1/d`) meets within `[0, t_max]`, roughly nearest first; `visit` returns
-    /// a lower `t_max` when it finds a hit.
+    /// Calls `visit(slot, t_max)` for every item (`items()[slot]`) whose box the ray
+    /// `o + t·d` (`inv_d = 1/d`) meets within `[0, t_max]`, nearest boxes first; `visit`
+    /// returns a lower `t_max` when it finds a hit.
     #[inline]
     pub fn traverse(
         &self,
         o: Vec3,
         inv_d: Vec3,
         mut t_max: f32,
-        mut visit: impl FnMut(u32) -> Option<f32>,
+        mut visit: impl FnMut(u32, f32) -> Option<f32>,
     ) {
         if self.nodes.is_empty() {
             return;
@@ -137,7 +137,7 @@ impl Bvh {
             }
             if count > 0 {
                 for slot in index..index + count {
-                    if let Some(t) = visit(slot) {
+                    if let Some(t) = visit(slot, t_max) {
                         t_max = t_max.min(t);
                     }
                 }

@@ -413,13 +413,24 @@ impl Spheres {
     }
 
     /// The first crossing of sphere `k` in `(t_min, t_max)`: `(t, entering, normal)`.
-    #[inline]
+    #[inline(never)]
     fn crossing(&self, k: usize, ray: &Ray, t_max: f64) -> Option<(f64, bool, DVec3)> {
-        // The direction renormalised in `f64`: the exact tests assume `d·d = 1`, which
-        // an `f32`-normalised direction misses by up to ~1e-7. Done here, for the few
-        // spheres that pass the quick test, not for every ray (caching it per ray
-        // measured 3.8% more instructions on hw3).
-        let (o, d, t_min) = (ray.o64, ray.d32.as_dvec3().normalize(), ray.t_min);
+        // Renormalised here, for the few spheres that pass the quick test (shadow rays
+        // mostly have none). Not inlined: inlined into the shadow loops, the
+        // normalisation was hoisted out of them, onto every shadow ray.
+        self.crossing_along(k, ray, unit64(ray.d32), t_max)
+    }
+
+    /// [`Spheres::crossing`] given the direction renormalised in `f64` ([`unit64`]).
+    #[inline]
+    fn crossing_along(
+        &self,
+        k: usize,
+        ray: &Ray,
+        d: DVec3,
+        t_max: f64,
+    ) -> Option<(f64, bool, DVec3)> {
+        let (o, t_min) = (ray.o64, ray.t_min);
         let (c, r, inv_r) = (self.center[k], self.radius[k], self.inv_radius[k]);
         let own = ray
             .from
@@ -449,14 +460,14 @@ impl Spheres {
         if own_outward || !self.may_cross(k as usize, ray, round_up(best.t)) {
             return None;
         }
-        self.consider_exactly(k, ray, best)
+        self.consider_exactly(k, ray, unit64(ray.d32), best)
     }
 
     /// [`Spheres::consider`] after the quick test passed.
     #[inline(always)]
-    fn consider_exactly(&self, k: u32, ray: &Ray, best: &mut Best) -> Option<f32> {
+    fn consider_exactly(&self, k: u32, ray: &Ray, d: DVec3, best: &mut Best) -> Option<f32> {
         let k = k as usize;
-        let (t, entering, normal) = self.crossing(k, ray, best.t)?;
+        let (t, entering, normal) = self.crossing_along(k, ray, d, best.t)?;
         *best = Best {
             t,
             k,
@@ -484,16 +495,23 @@ impl Spheres {
     /// The closest hit of a ray of any origin.
     pub fn closest(&self, q: &Query) -> Option<Hit> {
         let ray = Ray::new(q);
+        // Worked out first (most such rays test a sphere exactly, some several): its
+        // square root and division overlap the traversal.
+        let d64 = unit64(q.dir);
         let mut best = Best::NONE;
-        self.bvh
-            .traverse(q.origin.as_vec3(), q.dir.recip(), f32::INFINITY, |slot| {
+        self.bvh.traverse(
+            q.origin.as_vec3(),
+            q.dir.recip(),
+            f32::INFINITY,
+            |slot, t_max| {
                 let s = &self.leaf[slot as usize];
                 let own_outward = ray.from == Some((s.k, Side::Outward));
-                if own_outward || !may_cross(s.center, s.radius, &ray, round_up(best.t)) {
+                if own_outward || !may_cross(s.center, s.radius, &ray, t_max) {
                     return None;
                 }
-                self.consider_exactly(s.k, &ray, &mut best)
-            });
+                self.consider_exactly(s.k, &ray, d64, &mut best)
+            },
+        );
         self.finish(best)
     }
 
@@ -514,7 +532,7 @@ impl Spheres {
                 break; // the rest are all farther
             }
             if eye.quick[k as usize].may_cross(q.dir, t_max) {
-                if let Some(t) = self.consider_exactly(k, &ray, &mut best) {
+                if let Some(t) = self.consider_exactly(k, &ray, unit64(q.dir), &mut best) {
                     t_max = t;
                 }
             }
@@ -615,18 +633,22 @@ impl Spheres {
     pub fn shadow(&self, q: &Query, dist: f64) -> f32 {
         let ray = Ray::new(q);
         let mut factor = 1.0f32;
-        self.bvh
-            .traverse(q.origin.as_vec3(), q.dir.recip(), round_up(dist), |slot| {
+        self.bvh.traverse(
+            q.origin.as_vec3(),
+            q.dir.recip(),
+            round_up(dist),
+            |slot, t_max| {
                 let s = &self.leaf[slot as usize];
                 let own_outward = ray.from == Some((s.k, Side::Outward));
-                if !own_outward && may_cross(s.center, s.radius, &ray, round_up(dist)) {
+                if !own_outward && may_cross(s.center, s.radius, &ray, t_max) {
                     if let Some((_, _, n_k)) = self.crossing(s.k as usize, &ray, dist) {
                         factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
                     }
                 }
                 // A factor of 0 cannot go lower: stop looking.
                 (factor <= 0.0).then_some(-1.0)
-            });
+            },
+        );
         factor
     }
 
@@ -712,6 +734,13 @@ impl<'a> ShadowStart<'a> {
             candidates: grid.candidates(grid.cell((q.origin - grid.centre).as_vec3())),
         }
     }
+}
+
+/// The direction renormalised in `f64`: the exact tests assume `d·d = 1`, which an
+/// `f32`-normalised direction misses by up to ~1e-7.
+#[inline(always)]
+fn unit64(d: Vec3) -> DVec3 {
+    d.as_dvec3().normalize()
 }
 
 /// `false` when the sphere of centre `c` and widened `f32` radius `w` certainly has no
