@@ -4,16 +4,18 @@
 
 mod bvh;
 mod dirgrid;
+mod point;
 
 use glam::{DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 
 use bvh::{Aabb, Bvh};
 use dirgrid::DirGrid;
+pub use point::{EyeGrid, PointGrid};
 
 use crate::model::Side;
 use crate::scene::Sphere;
-use crate::trace::intersect::{roots, roots_from};
+use crate::trace::intersect::roots;
 
 /// The closest hit of a ray.
 #[derive(Clone, Copy, Debug)]
@@ -80,125 +82,6 @@ fn grid_resolution(spheres: usize) -> u32 {
         128
     } else {
         256
-    }
-}
-
-/// A directional grid around a point (the camera origin or a light), with what the
-/// quick test of a ray through that point needs of each sphere worked out once: only
-/// the direction varies between such rays.
-pub struct PointGrid {
-    grid: DirGrid,
-    quick: Vec<PointQuick>,
-    /// Around the eye only: per sphere, all that a primary ray's tests read of it.
-    exact: Vec<EyeSphere>,
-}
-
-impl PointGrid {
-    /// Whether [`Spheres::closest_from_eye`] may use its shortcut: an eye grid, and the
-    /// eye inside no sphere (else the general query runs).
-    fn eye_shortcut_applies(&self) -> bool {
-        self.grid.always.is_empty() && !self.exact.is_empty()
-    }
-
-    fn query(&self, d: Vec3) -> Query {
-        Query {
-            origin: self.grid.centre,
-            dir: d,
-            from: None,
-        }
-    }
-}
-
-/// What a primary ray needs before its candidates are tested.
-struct EyeStart<'a> {
-    /// As in `crossing`: the direction renormalised in `f64`, once, first: its square
-    /// root and division then run while the grid is read, off the hit's critical path.
-    d64: DVec3,
-    /// The spheres of its cell, nearest first.
-    candidates: &'a [(u32, f32)],
-}
-
-impl<'a> EyeStart<'a> {
-    #[inline(always)]
-    fn new(eye: &'a EyeGrid, d: Vec3) -> Self {
-        EyeStart {
-            d64: d.as_dvec3().normalize(),
-            candidates: eye.grid.candidates(eye.grid.cell(d)),
-        }
-    }
-}
-
-/// A sphere as primary rays test it: the quick test's constants and the origin's part
-/// of the exact test (`eye − centre` and `|eye − centre|² − r²` in `f64`), side by side.
-#[derive(Clone, Copy)]
-struct EyeSphere {
-    quick: PointQuick,
-    f: DVec3,
-    cterm: f64,
-    radius: f64,
-    inv_radius: f64,
-}
-
-/// The grid around a camera origin (see [`Spheres::eye_grid`]).
-pub type EyeGrid = PointGrid;
-
-/// One sphere as the quick test of rays through a grid's point sees it (see
-/// [`PointQuick::may_cross`]).
-#[derive(Clone, Copy)]
-struct PointQuick {
-    /// `point − centre` in `f32`.
-    f: Vec3,
-    /// A ray of unit direction `d` misses when `(f·d)²` is below this: the closest
-    /// point of its line is then farther than the (widened) radius plus the slack.
-    min_bp2: f32,
-    /// The (widened) radius plus slack: the crossings lie within `reach` of `−f·d`.
-    reach: f32,
-    /// The widened radius.
-    radius: f32,
-}
-
-impl PointQuick {
-    fn new(point: DVec3, centre: DVec3, quick: Vec4) -> Self {
-        // The quantities of `Spheres::may_cross` for this origin, with the test
-        // `|l|² > r² + slack` rewritten as `(f·d)² < |f|² − r² − slack`
-        // (`|l|² = |f|² − (f·d)²`). The rewrite adds rounding of a few ε·|f|², far
-        // below the slack of 2⁻¹⁸·(r² + |f|²), and the bound is rounded down.
-        let f = (point - centre).as_vec3();
-        let (w, ff) = (f64::from(quick.w), f64::from(f.dot(f)));
-        let slack = f64::from(QUICK_SLACK) * (w * w + ff);
-        let min_bp2 = ff - w * w - 2.0 * slack;
-        let rounded = min_bp2 as f32;
-        let min_bp2 = if f64::from(rounded) > min_bp2 {
-            rounded.next_down()
-        } else {
-            rounded
-        };
-        let ff = f.dot(f);
-        PointQuick {
-            f,
-            min_bp2,
-            reach: quick.w + QUICK_SLACK * (ff.sqrt() + quick.w),
-            radius: quick.w,
-        }
-    }
-
-    /// `false` when a ray from the point with unit direction `d` certainly misses the
-    /// sphere in `(0, t_max)`.
-    #[inline(always)]
-    fn may_cross(&self, d: Vec3, t_max: f32) -> bool {
-        let bp = -self.f.dot(d);
-        bp * bp >= self.min_bp2 && bp + self.reach > 0.0 && bp - self.reach < t_max
-    }
-
-    /// [`PointQuick::may_cross`] for a ray whose line may pass up to `offset` from the
-    /// point (the sphere is widened by `offset`).
-    #[inline(always)]
-    fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
-        let bp = -self.f.dot(d);
-        let reach = self.reach + offset;
-        bp * bp + offset * (2.0 * self.radius + offset) >= self.min_bp2
-            && bp + reach > 0.0
-            && bp - reach < t_max
     }
 }
 
@@ -351,44 +234,6 @@ impl Spheres {
         )
     }
 
-    /// `grid` with the quick-test constants of its point.
-    fn point_grid(&self, grid: DirGrid) -> PointGrid {
-        let point = grid.centre;
-        let quick = self
-            .center
-            .iter()
-            .zip(&self.quick)
-            .map(|(&c, &q)| PointQuick::new(point, c, q))
-            .collect();
-        PointGrid {
-            grid,
-            quick,
-            exact: Vec::new(),
-        }
-    }
-
-    /// `grid` around the eye: [`Spheres::point_grid`] with the exact test's constants.
-    fn eye_point_grid(&self, grid: DirGrid) -> EyeGrid {
-        let eye = grid.centre;
-        let point = self.point_grid(grid);
-        let exact = point
-            .quick
-            .iter()
-            .zip(self.center.iter().zip(&self.radius))
-            .map(|(&quick, (&c, &radius))| {
-                let f = eye - c;
-                EyeSphere {
-                    quick,
-                    f,
-                    cterm: f.dot(f) - radius * radius,
-                    radius,
-                    inv_radius: 1.0 / radius,
-                }
-            })
-            .collect();
-        PointGrid { exact, ..point }
-    }
-
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
     /// the only part of the structures that depends on the camera.
     pub fn eye_grid(&self, eye: DVec3) -> EyeGrid {
@@ -515,108 +360,6 @@ impl Spheres {
         self.finish(best)
     }
 
-    /// The closest hit of a primary ray: a ray from the centre of `eye`.
-    pub fn closest_primary(&self, eye: &EyeGrid, q: &Query) -> Option<Hit> {
-        let grid = &eye.grid;
-        if grid.centre != q.origin || q.from.is_some() {
-            return self.closest(q);
-        }
-        let ray = Ray::new(q);
-        let mut best = Best::NONE;
-        for &k in &grid.always {
-            self.consider(k, &ray, &mut best);
-        }
-        let mut t_max = round_up(best.t);
-        for &(k, near) in grid.candidates(grid.cell(q.dir)) {
-            if near >= t_max {
-                break; // the rest are all farther
-            }
-            if eye.quick[k as usize].may_cross(q.dir, t_max) {
-                if let Some(t) = self.consider_exactly(k, &ray, unit64(q.dir), &mut best) {
-                    t_max = t;
-                }
-            }
-        }
-        self.finish(best)
-    }
-
-    /// [`Spheres::closest_primary`] for the ray from the eye with unit direction `d`,
-    /// with the origin's part of every test worked out beforehand (same results).
-    pub fn closest_from_eye(&self, eye: &EyeGrid, d: Vec3) -> Option<Hit> {
-        if !eye.eye_shortcut_applies() {
-            return self.closest_primary(eye, &eye.query(d));
-        }
-        let start = EyeStart::new(eye, d);
-        self.closest_from_start(eye, d, start)
-    }
-
-    /// [`Spheres::closest_from_eye`] of two rays at once: each ray's answer is a chain
-    /// of long-latency steps (square roots, divisions, dependent loads); set side by
-    /// side, the processor overlaps the two chains.
-    pub fn closest_from_eye_pair(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> [Option<Hit>; 2] {
-        if !eye.eye_shortcut_applies() {
-            return [
-                self.closest_primary(eye, &eye.query(a)),
-                self.closest_primary(eye, &eye.query(b)),
-            ];
-        }
-        let (start_a, start_b) = (EyeStart::new(eye, a), EyeStart::new(eye, b));
-        [
-            self.closest_from_start(eye, a, start_a),
-            self.closest_from_start(eye, b, start_b),
-        ]
-    }
-
-    #[inline(always)]
-    fn closest_from_start(&self, eye: &EyeGrid, d: Vec3, start: EyeStart<'_>) -> Option<Hit> {
-        let d64 = start.d64;
-        let mut best = Best::NONE;
-        let mut t_max = f32::INFINITY;
-        for &(k, near) in start.candidates {
-            if near >= t_max {
-                break; // the rest are all farther
-            }
-            let k = k as usize;
-            let sphere = &eye.exact[k];
-            if !sphere.quick.may_cross(d, t_max) {
-                continue;
-            }
-            let r = sphere.radius;
-            let Some(rt) = roots_from(sphere.f, sphere.cterm, d64, r) else {
-                continue;
-            };
-            // `crossing` for a ray with no spawn sphere and `t_min = 0`.
-            let inv_r = sphere.inv_radius;
-            let (t, entering, normal) = if rt.near > 0.0 && rt.near < best.t {
-                (rt.near, true, rt.normal_near_scaled(d64, inv_r))
-            } else if rt.far > 0.0 && rt.far < best.t {
-                (rt.far, false, rt.normal_far_scaled(d64, inv_r))
-            } else {
-                continue;
-            };
-            best = Best {
-                t,
-                k,
-                entering,
-                normal,
-            };
-            t_max = round_up(t);
-        }
-        self.finish(best)
-    }
-
-    /// `true` when no ray from the eye with a direction between `a` and `b` (unit
-    /// vectors; the directions of one image row between two pixels, say) can meet a
-    /// sphere. So when `a` and `b` fall in one empty cell of the eye grid: a cell is a
-    /// square in its face's plane, the rows' directions between project to the segment
-    /// between, inside it; and cells list every sphere seen within a widened cone,
-    /// which covers the rounding of the directions many times over.
-    pub fn eye_sees_nothing_between(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> bool {
-        let grid = &eye.grid;
-        let cell = grid.cell(a);
-        grid.always.is_empty() && cell == grid.cell(b) && grid.candidates(cell).is_empty()
-    }
-
     /// Lowers `factor` by sphere `k`'s occlusion of the shadow segment.
     #[inline(always)]
     fn occlude(&self, k: u32, ray: &Ray, dist: f64, factor: &mut f32) {
@@ -650,89 +393,6 @@ impl Spheres {
             },
         );
         factor
-    }
-
-    /// The shadow factor along the segment of length `dist` towards light `light`.
-    pub fn shadow_to_light(&self, q: &Query, dist: f64, light: usize) -> f32 {
-        let Some(lg) = self.lights.get(light) else {
-            return self.shadow(q, dist);
-        };
-        let start = ShadowStart::new(lg, q, dist);
-        self.shadow_from_start(lg, &start)
-    }
-
-    /// [`Spheres::shadow_to_light`] of two segments at once (see
-    /// [`Spheres::closest_from_eye_pair`]).
-    pub fn shadow_to_light_pair(
-        &self,
-        a: (&Query, f64),
-        b: (&Query, f64),
-        light: usize,
-    ) -> [f32; 2] {
-        let Some(lg) = self.lights.get(light) else {
-            return [self.shadow(a.0, a.1), self.shadow(b.0, b.1)];
-        };
-        let (start_a, start_b) = (
-            ShadowStart::new(lg, a.0, a.1),
-            ShadowStart::new(lg, b.0, b.1),
-        );
-        [
-            self.shadow_from_start(lg, &start_a),
-            self.shadow_from_start(lg, &start_b),
-        ]
-    }
-
-    #[inline(always)]
-    fn shadow_from_start(&self, lg: &PointGrid, start: &ShadowStart<'_>) -> f32 {
-        let (ray, dist) = (&start.ray, start.dist);
-        let mut factor = 1.0f32;
-        for &k in &lg.grid.always {
-            self.occlude(k, ray, dist, &mut factor);
-        }
-        for &(k, near) in start.candidates {
-            if f64::from(near) >= dist || factor <= 0.0 {
-                break; // beyond the hit point, seen from the light
-            }
-            if ray.from == Some((k, Side::Outward))
-                || !lg.quick[k as usize].may_cross_near(start.back, start.dist32, start.offset)
-            {
-                continue;
-            }
-            if let Some((_, _, n_k)) = self.crossing(k as usize, ray, dist) {
-                factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
-            }
-        }
-        factor
-    }
-}
-
-/// What a shadow segment needs before its candidates are tested.
-struct ShadowStart<'a> {
-    ray: Ray,
-    dist: f64,
-    dist32: f32,
-    /// The segment seen from the light.
-    back: Vec3,
-    /// The quick test runs from the light, back along the segment: the line through
-    /// the light with the (rounded) direction passes within this of the segment's
-    /// start (the direction is off by at most ~1.5e-7 radians).
-    offset: f32,
-    /// The spheres of its cell of the light's grid, nearest the light first.
-    candidates: &'a [(u32, f32)],
-}
-
-impl<'a> ShadowStart<'a> {
-    #[inline(always)]
-    fn new(lg: &'a PointGrid, q: &Query, dist: f64) -> Self {
-        let grid = &lg.grid;
-        ShadowStart {
-            ray: Ray::new(q),
-            dist,
-            dist32: round_up(dist),
-            back: -q.dir,
-            offset: (4e-7 * dist) as f32,
-            candidates: grid.candidates(grid.cell((q.origin - grid.centre).as_vec3())),
-        }
     }
 }
 
