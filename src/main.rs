@@ -50,6 +50,10 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
         threads: Option<u32>,
+        /// Time the viewer instead: this many views orbiting the scene, each rendered
+        /// as the window renders it (no window; the blit is not included).
+        #[arg(long, value_name = "VIEWS", value_parser = clap::value_parser!(u32).range(1..=100000))]
+        orbit: Option<u32>,
     },
     /// Measure run time against error over a grid of quality settings on several
     /// scenes; writes bench.csv, bench.md and bench.svg (docs/quality.md).
@@ -203,7 +207,8 @@ fn main() -> ExitCode {
             scene,
             runs,
             threads,
-        }) => time_command(scene.as_deref(), runs, threads),
+            orbit,
+        }) => time_command(scene.as_deref(), runs, threads, orbit),
         Some(Command::Scene { name: _, seed }) => scene_command(seed),
     };
     match result {
@@ -266,12 +271,28 @@ fn scene_command(seed: u64) -> anyhow::Result<()> {
     }
 }
 
-fn time_command(path: Option<&Path>, runs: usize, threads: Option<u32>) -> anyhow::Result<()> {
+fn time_command(
+    path: Option<&Path>,
+    runs: usize,
+    threads: Option<u32>,
+    orbit: Option<u32>,
+) -> anyhow::Result<()> {
     let scene = load_scene(path)?;
+    let name = path.map_or("hw3".to_string(), |p| p.display().to_string());
+    if let Some(views) = orbit {
+        let size = (scene.image.width, scene.image.height);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.map_or(0, |t| t as usize))
+            .build()
+            .context("cannot start the threads")?;
+        let timing = pool.install(|| whitted::speed::time_orbit(&scene, size, views as usize))?;
+        let line = timing.result_line(&name, pool.current_num_threads(), size);
+        println!("{line}");
+        return Ok(());
+    }
     let mut opts = RenderOptions::for_scene(&scene);
     opts.threads = threads.map(|t| t as usize);
     let timing = whitted::speed::time_render(&scene, &opts, runs)?;
-    let name = path.map_or("hw3".to_string(), |p| p.display().to_string());
     println!("{}", timing.result_line(&name, &opts, scene.spheres.len()));
     Ok(())
 }

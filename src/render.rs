@@ -354,7 +354,8 @@ fn film(opts: &RenderOptions, i: u32, j: u32, k: u32) -> (f32, f32) {
 
 /// Adds samples `samples` of every pixel of the area into `sums` (area-sized, row 0 at
 /// the bottom of the area), in sample order, so that any split into passes sums the
-/// same numbers in the same order.
+/// same numbers in the same order. A range from sample 0 starts the sums afresh
+/// (whatever `sums` held), so a reused buffer needs no clearing.
 pub fn accumulate<T: SampleTracer + ?Sized>(
     tracer: &T,
     opts: &RenderOptions,
@@ -364,18 +365,19 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
 ) -> Result<RayCounts, RenderError> {
     let area = opts.area();
     if opts.image.spp == 1 && samples == (0..1) {
-        // One sample a pixel, at its centre: whole rows at once, as `render` does.
+        // One sample a pixel, at its centre: whole rows at once, written in place, as
+        // `render` does.
         let centres = pixel_centres(opts, area);
         return for_each_row(opts, area, sums, 1, 1, control, |j, row, counts| {
-            let mut colours = vec![Vec3::ZERO; row.len()];
-            tracer.sample_row(&centres, centre_height(opts, j), &mut colours, counts);
-            for (sum, c) in row.iter_mut().zip(colours) {
-                *sum += c;
-            }
+            tracer.sample_row(&centres, centre_height(opts, j), row, counts);
         });
     }
     let n = samples.len() as u64;
+    let afresh = samples.start == 0;
     for_each_pixel(opts, area, sums, 1, n, control, |i, j, sum, counts| {
+        if afresh {
+            sum[0] = Vec3::ZERO;
+        }
         for k in samples.clone() {
             let (s, t) = film(opts, i, j, k);
             sum[0] += tracer.sample(s, t, counts);
@@ -397,7 +399,7 @@ pub fn resolve(sums: &[Vec3], samples: u32, width: u32, height: u32) -> Frame {
 
 /// A sum of `samples` samples as a finite pixel value.
 #[inline]
-fn pixel_value(sum: Vec3, samples: u32) -> Vec3 {
+pub fn pixel_value(sum: Vec3, samples: u32) -> Vec3 {
     let c = sum / samples.max(1) as f32;
     if c.is_finite() {
         c

@@ -89,3 +89,116 @@ pub fn time_render(
         rays,
     })
 }
+
+/// The viewer's frames while the camera orbits: see [`time_orbit`].
+#[derive(Clone, Debug)]
+pub struct OrbitTiming {
+    /// Seconds of each view's first full-resolution pass (what the window then shows),
+    /// conversion to screen bytes included.
+    pub frame_seconds: Vec<f64>,
+    /// Views that showed a preview before their full pass.
+    pub previews: usize,
+    /// Wall time of all the views, from the first submission to the last frame.
+    pub wall_seconds: f64,
+}
+
+impl OrbitTiming {
+    /// Median seconds of a full-resolution frame.
+    pub fn median_frame_seconds(&self) -> f64 {
+        median(&mut self.frame_seconds.clone())
+    }
+
+    /// Full-resolution frames per second of wall time (everything the worker does
+    /// between frames included: a new view's eye grid, previews).
+    pub fn frames_per_second(&self) -> f64 {
+        self.frame_seconds.len() as f64 / self.wall_seconds.max(1e-9)
+    }
+
+    /// One line in the form of [`Timing::result_line`].
+    pub fn result_line(&self, scene: &str, threads: usize, (w, h): (u32, u32)) -> String {
+        format!(
+            "RESULT peer=whitted-viewer scene={scene} threads={threads} size={w}x{h} views={} \
+             frame_ms={:.2} best_ms={:.2} fps={:.1} previews={}",
+            self.frame_seconds.len(),
+            self.median_frame_seconds() * 1e3,
+            self.frame_seconds
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min)
+                * 1e3,
+            self.frames_per_second(),
+            self.previews,
+        )
+    }
+}
+
+/// Orbits the camera of `scene` (one sample a pixel) by a short mouse drag per view,
+/// `views` times after one warm-up view, and renders each view at `size` exactly as
+/// the viewer's window does — its worker's passes, tracer cache and buffers, its
+/// choice of preview from the speed measured so far — without a window: the render
+/// time per frame of the viewer, apart from the blit.
+pub fn time_orbit(
+    scene: &Scene,
+    size: (u32, u32),
+    views: usize,
+) -> Result<OrbitTiming, RenderError> {
+    use crate::viewer::controls::{Action, CameraControl};
+    use crate::viewer::schedule::preview_factor;
+    use crate::viewer::worker::{self, Buffers, Job, Report, TracerCache};
+    use std::sync::Arc;
+    use std::time::Instant;
+
+    let mut scene = scene.clone();
+    scene.image.spp = 1;
+    let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
+    let mut camera = CameraControl::new(&scene);
+    let mut speed = f64::NAN;
+    let mut timing = OrbitTiming {
+        frame_seconds: Vec::new(),
+        previews: 0,
+        wall_seconds: 0.0,
+    };
+    let mut start = Instant::now();
+    for view in 0..=views {
+        let drag = Action::Drag {
+            dx: 10.0,
+            dy: 0.0,
+            height: size.1,
+        };
+        camera.apply(&scene, size.0, size.1, drag);
+        let mut seen = scene.clone();
+        seen.camera = Some(camera.spec(&scene, size.0, size.1));
+        let job = Job::new(
+            view as u64,
+            Arc::new(seen),
+            size,
+            preview_factor(size.0, size.1, speed),
+        );
+        let reports = std::cell::RefCell::new(Vec::new());
+        worker::run(&job, &mut cache, &mut buffers, &|r| {
+            reports.borrow_mut().push(r)
+        })?;
+        let mut shown = Vec::new();
+        for report in reports.into_inner() {
+            match report {
+                Report::Frame(s) => shown.push(s),
+                Report::Failed { message, .. } => return Err(RenderError::Invalid(message)),
+            }
+        }
+        for s in &shown {
+            if s.pass_seconds > 0.0 {
+                speed = s.pass_pixels as f64 / s.pass_seconds;
+            }
+        }
+        if view == 0 {
+            start = Instant::now(); // the warm-up view: thread pool, caches
+            continue;
+        }
+        timing.previews += usize::from(shown.iter().any(|s| s.preview));
+        if let Some(full) = shown.iter().find(|s| !s.preview) {
+            timing.frame_seconds.push(full.pass_seconds);
+        }
+    }
+    timing.wall_seconds = start.elapsed().as_secs_f64();
+    Ok(timing)
+}

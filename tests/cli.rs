@@ -294,3 +294,48 @@ fn scene_printing_fails_cleanly_when_stdout_cannot_be_written() {
     // A clear error and status 1, not a panic (status 101).
     assert_fails_with(&out, &["standard output"]);
 }
+
+/// The value of `key=` in a RESULT line.
+fn field<'a>(line: &'a str, key: &str) -> &'a str {
+    line.split_whitespace()
+        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+        .unwrap_or_else(|| panic!("no {key} in {line}"))
+}
+
+#[test]
+fn time_prints_one_result_line_for_renders_and_for_orbits() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("small.toml");
+    let mut text = whitted::scene::hw3_toml(whitted::scene::HW3_DEFAULT_SEED);
+    text = text
+        .replace("width = 1280", "width = 64")
+        .replace("height = 720", "height = 36");
+    std::fs::write(&scene, text).unwrap();
+    let scene = scene.to_str().unwrap();
+
+    let out = whitted(&["time", scene, "--runs", "2", "--threads", "1"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(line.lines().count(), 1, "{line}");
+    assert!(line.starts_with("RESULT peer=whitted "), "{line}");
+    assert_eq!(field(&line, "size"), "64x36");
+    assert_eq!(field(&line, "runs"), "2");
+    assert_eq!(field(&line, "primary"), (64 * 36).to_string());
+    let count = |k| field(&line, k).parse::<u64>().unwrap();
+    assert_eq!(
+        count("rays"),
+        count("primary") + count("shadow") + count("secondary")
+    );
+
+    let out = whitted(&["time", scene, "--orbit", "3", "--threads", "2"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = String::from_utf8(out.stdout).unwrap();
+    assert!(line.starts_with("RESULT peer=whitted-viewer "), "{line}");
+    assert_eq!(field(&line, "threads"), "2");
+    assert_eq!(field(&line, "views"), "3");
+    // 64×36 is below the preview's smallest size: every view is one full pass.
+    assert_eq!(field(&line, "previews"), "0");
+    let ms: f64 = field(&line, "frame_ms").parse().unwrap();
+    let fps: f64 = field(&line, "fps").parse().unwrap();
+    assert!(ms > 0.0 && fps > 0.0, "{line}");
+}

@@ -3,6 +3,7 @@
 //! with the same byte conversion as the files ([`to_byte`]) so that a screenshot at
 //! 1:1 equals the saved image.
 
+use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::image_io::to_byte;
@@ -13,35 +14,67 @@ use super::schedule::preview_source;
 /// The frame as RGBA bytes, row 0 at the top, alpha 255 (the layout of `pixels`).
 /// Rows in parallel: serially this took a fifth of a full-resolution pass.
 pub fn to_rgba_top_down(frame: &Frame) -> Vec<u8> {
-    let w = frame.width as usize;
-    let mut bytes = vec![0u8; w * frame.height as usize * 4];
+    let w = (frame.width as usize).max(1);
+    let mut bytes = vec![0u8; frame.pixels.len() * 4];
     bytes
-        .par_chunks_mut(w.max(1) * 4)
-        .zip(frame.pixels.par_chunks(w.max(1)).rev())
-        .for_each(|(out, row)| {
-            for (o, p) in out.chunks_exact_mut(4).zip(row) {
-                o.copy_from_slice(&[to_byte(p.x), to_byte(p.y), to_byte(p.z), 255]);
-            }
-        });
+        .par_chunks_mut(w * 4)
+        .zip(frame.pixels.par_chunks(w).rev())
+        .for_each(|(out, row)| rgba_row(row, out));
     bytes
 }
 
-/// A `width`×`height` frame showing `preview` (rendered at 1/`factor` of the size)
-/// with each of its pixels as a `factor`×`factor` block, anchored at the bottom-left
-/// like the image.
+/// One row of pixels as RGBA bytes.
+#[inline]
+fn rgba_row(pixels: &[Vec3], out: &mut [u8]) {
+    for (o, p) in out.chunks_exact_mut(4).zip(pixels) {
+        o.copy_from_slice(&[to_byte(p.x), to_byte(p.y), to_byte(p.z), 255]);
+    }
+}
+
+/// Fills every row of `frame` (its size set beforehand) with `row(j, pixels)`, `j`
+/// counted from the bottom, and writes the same rows into `rgba` (resized to fit) as
+/// RGBA bytes, row 0 at the top, alpha 255 (the layout of `pixels`). Rows run in
+/// parallel and each row is converted while it is still in cache; the buffers may be
+/// reused ones, as every byte is written.
+pub fn fill_for_screen(
+    frame: &mut Frame,
+    rgba: &mut Vec<u8>,
+    row: impl Fn(usize, &mut [Vec3]) + Sync,
+) {
+    let w = (frame.width as usize).max(1);
+    let n = frame.width as usize * frame.height as usize;
+    frame.pixels.resize(n, Vec3::ZERO);
+    rgba.resize(n * 4, 0);
+    frame
+        .pixels
+        .par_chunks_mut(w)
+        .zip(rgba.par_chunks_mut(w * 4).rev())
+        .enumerate()
+        .for_each(|(j, (pixels, out))| {
+            row(j, pixels);
+            rgba_row(pixels, out);
+        });
+}
+
+/// Row `j` (from the bottom) of `frame` when it shows `preview` (rendered at
+/// 1/`factor` of the size) with each of its pixels as a `factor`×`factor` block,
+/// anchored at the bottom-left like the image.
+pub fn upscaled_row(preview: &Frame, factor: u32, j: usize, row: &mut [Vec3]) {
+    for (i, p) in row.iter_mut().enumerate() {
+        let (pi, pj) = preview_source(i as u32, j as u32, factor);
+        let (pi, pj) = (pi.min(preview.width - 1), pj.min(preview.height - 1));
+        *p = preview.get(pi, pj);
+    }
+}
+
+/// A `width`×`height` frame showing `preview` scaled up (see [`upscaled_row`]).
 pub fn upscale(preview: &Frame, factor: u32, width: u32, height: u32) -> Frame {
     let mut frame = Frame::new(width, height);
     frame
         .pixels
         .par_chunks_mut(width.max(1) as usize)
         .enumerate()
-        .for_each(|(j, row)| {
-            for (i, p) in row.iter_mut().enumerate() {
-                let (pi, pj) = preview_source(i as u32, j as u32, factor);
-                let (pi, pj) = (pi.min(preview.width - 1), pj.min(preview.height - 1));
-                *p = preview.get(pi, pj);
-            }
-        });
+        .for_each(|(j, row)| upscaled_row(preview, factor, j, row));
     frame
 }
 
@@ -99,7 +132,6 @@ pub fn window_to_pixel(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
 
     /// A 3×2 frame whose pixels encode their coordinates.
     fn frame() -> Frame {

@@ -107,7 +107,7 @@ struct App {
     first_frame_reported: bool,
     /// Holds camera changes while the current view has nothing on screen.
     throttle: schedule::Throttle,
-    /// Pixel samples per second of the last pass, to size the next preview.
+    /// Pixels per second of the last one-sample pass, to size the next preview.
     speed: f64,
     error: Option<anyhow::Error>,
 }
@@ -274,7 +274,10 @@ impl App {
         if shown.generation != self.generation {
             return; // a stale pass of a cancelled view
         }
-        if shown.pass_seconds > 0.0 {
+        // The speed of one-sample passes (previews and first full passes) sizes the
+        // next preview, or skips it.
+        let one_sample = shown.samples <= 1;
+        if one_sample && shown.pass_seconds > 0.0 {
             self.speed = shown.pass_pixels as f64 / shown.pass_seconds;
         }
         self.progress = if shown.preview {

@@ -32,24 +32,28 @@ pub enum Pass {
 }
 
 /// The preview factor for a `width`×`height` view that renders a preview within
-/// [`PREVIEW_SECONDS`] at `pixels_per_second` (measured on earlier previews).
+/// [`PREVIEW_SECONDS`] at `pixels_per_second` (measured on earlier one-sample passes);
+/// 1 (no preview) when the full view itself renders within that time: a preview would
+/// then only put a coarse picture in front of every frame of a drag.
 pub fn preview_factor(width: u32, height: u32, pixels_per_second: f64) -> u32 {
     if !(pixels_per_second.is_finite() && pixels_per_second > 0.0) {
         return START_PREVIEW_FACTOR;
     }
     let budget = (pixels_per_second * PREVIEW_SECONDS).max(1.0);
-    let factor = (f64::from(width) * f64::from(height) / budget)
-        .sqrt()
-        .ceil();
+    let pixels = f64::from(width) * f64::from(height);
+    if pixels <= budget {
+        return 1;
+    }
+    let factor = (pixels / budget).sqrt().ceil();
     (factor as u32).clamp(MIN_PREVIEW_FACTOR, MAX_PREVIEW_FACTOR)
 }
 
 /// The passes for a `width`×`height` view with `spp` samples per pixel, starting
-/// with a preview at 1/`factor` of the size.
+/// with a preview at 1/`factor` of the size (none for a factor of 1).
 pub fn plan(width: u32, height: u32, spp: u32, factor: u32) -> Vec<Pass> {
     let mut passes = Vec::new();
-    let factor = factor.max(MIN_PREVIEW_FACTOR);
-    if u64::from(width) * u64::from(height) >= PREVIEW_MIN_PIXELS {
+    if factor > 1 && u64::from(width) * u64::from(height) >= PREVIEW_MIN_PIXELS {
+        let factor = factor.max(MIN_PREVIEW_FACTOR);
         passes.push(Pass::Preview {
             width: width.div_ceil(factor),
             height: height.div_ceil(factor),
@@ -155,6 +159,22 @@ mod tests {
     }
 
     #[test]
+    fn no_preview_when_the_full_view_fits_the_time_budget() {
+        // 921 600 pixels in 1/30 s need 27.6 Mpixel/s; just above, no preview.
+        let fits = 1280.0 * 720.0 / PREVIEW_SECONDS;
+        assert_eq!(preview_factor(1280, 720, fits * 1.01), 1);
+        assert_eq!(preview_factor(1280, 720, fits * 0.99), MIN_PREVIEW_FACTOR);
+        assert_eq!(
+            plan(1280, 720, 4, 1),
+            vec![
+                Pass::Samples(0..1),
+                Pass::Samples(1..2),
+                Pass::Samples(2..4)
+            ]
+        );
+    }
+
+    #[test]
     fn batches_cover_all_samples_in_order() {
         for spp in [1, 2, 3, 5, 16, 17, 100, 1000] {
             let ranges = samples(&plan(320, 180, spp, 4));
@@ -180,7 +200,7 @@ mod tests {
         let (w, h) = (1280 / 5, 720 / 5);
         assert!(f64::from(w * h) <= 1.2e6 / 30.0);
         // Clamped at both ends, and a sane start without a measurement.
-        assert_eq!(preview_factor(1280, 720, 1e12), MIN_PREVIEW_FACTOR);
+        assert_eq!(preview_factor(1280, 720, 2.0e7), MIN_PREVIEW_FACTOR);
         assert_eq!(preview_factor(1280, 720, 1.0), MAX_PREVIEW_FACTOR);
         assert_eq!(preview_factor(1280, 720, f64::NAN), START_PREVIEW_FACTOR);
         assert_eq!(preview_factor(1280, 720, 0.0), START_PREVIEW_FACTOR);

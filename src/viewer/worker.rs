@@ -4,6 +4,7 @@
 //! loop. A new job cancels the running one through its [`RenderControl`], so stale
 //! work stops within a row of pixels; the worker then skips to the newest job.
 
+use std::collections::VecDeque;
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -17,7 +18,7 @@ use crate::scene::Scene;
 use crate::trace::fast::FastTracer;
 use crate::trace::SampleTracer;
 
-use super::buffer::{to_rgba_top_down, upscale};
+use super::buffer::{fill_for_screen, upscaled_row};
 use super::schedule::{plan, Pass};
 
 /// One view to render: the scene (its camera is the view's), at this size.
@@ -56,6 +57,27 @@ pub struct Shown {
     pub since_submit: f64,
 }
 
+impl Job {
+    /// A view to render at `width`×`height`, with its preview at 1/`preview_factor`
+    /// of the size.
+    pub fn new(
+        generation: u64,
+        scene: Arc<Scene>,
+        (width, height): (u32, u32),
+        preview_factor: u32,
+    ) -> Job {
+        Job {
+            generation,
+            scene,
+            width,
+            height,
+            preview_factor,
+            control: Arc::new(RenderControl::default()),
+            submitted: Instant::now(),
+        }
+    }
+}
+
 pub enum Report {
     Frame(Shown),
     Failed { generation: u64, message: String },
@@ -92,17 +114,8 @@ impl Worker {
         preview_factor: u32,
     ) {
         self.cancel();
-        let control = Arc::new(RenderControl::default());
-        self.current = Some(Arc::clone(&control));
-        let job = Job {
-            generation,
-            scene,
-            width,
-            height,
-            preview_factor,
-            control,
-            submitted: Instant::now(),
-        };
+        let job = Job::new(generation, scene, (width, height), preview_factor);
+        self.current = Some(Arc::clone(&job.control));
         if let Some(jobs) = &self.jobs {
             // The thread only ends when this sender is dropped, so this cannot fail
             // unless it panicked; then there is nothing better to do than not render.
@@ -130,12 +143,13 @@ impl Drop for Worker {
 
 fn serve(rx: Receiver<Job>, sink: impl Fn(Report)) {
     let mut cache = TracerCache::default();
+    let mut buffers = Buffers::default();
     while let Ok(mut job) = rx.recv() {
         // Only the newest queued view matters.
         while let Ok(newer) = rx.try_recv() {
             job = newer;
         }
-        match run(&job, &mut cache, &sink) {
+        match run(&job, &mut cache, &mut buffers, &sink) {
             Ok(()) | Err(RenderError::Cancelled) => {}
             Err(RenderError::Invalid(message)) => sink(Report::Failed {
                 generation: job.generation,
@@ -170,8 +184,61 @@ impl TracerCache {
     }
 }
 
+/// The buffers of the passes, kept from view to view: a fresh full-size buffer for
+/// every pass costs its page faults (a 1280×720 frame is 11 MB of `Vec3`), serially,
+/// on the critical path of every frame.
+#[derive(Default)]
+pub struct Buffers {
+    /// Sums of samples at full size (see `render::accumulate`: a pass from sample 0
+    /// restarts them, so they are never cleared).
+    sums: Vec<Vec3>,
+    preview_sums: Vec<Vec3>,
+    /// What the window was sent, taken back once it has let go.
+    frames: Recycler<Frame>,
+    rgba: Recycler<Vec<u8>>,
+}
+
+/// Values handed out behind an `Arc`, reused once nobody else holds them.
+struct Recycler<T> {
+    sent: VecDeque<Arc<T>>,
+}
+
+impl<T> Default for Recycler<T> {
+    fn default() -> Self {
+        Recycler {
+            sent: VecDeque::new(),
+        }
+    }
+}
+
+impl<T> Recycler<T> {
+    /// The window holds what it shows and the report in flight; a save may hold one.
+    const KEPT: usize = 4;
+
+    /// A value sent earlier that nobody holds any more, if any.
+    fn take(&mut self) -> Option<T> {
+        let free = self.sent.iter().position(|a| Arc::strong_count(a) == 1)?;
+        Arc::try_unwrap(self.sent.remove(free)?).ok()
+    }
+
+    /// `value`, shared, remembered for a later [`Recycler::take`].
+    fn send(&mut self, value: T) -> Arc<T> {
+        let shared = Arc::new(value);
+        self.sent.push_back(Arc::clone(&shared));
+        if self.sent.len() > Self::KEPT {
+            self.sent.pop_front();
+        }
+        shared
+    }
+}
+
 /// Renders all passes of `job`, reporting each; stops early when cancelled.
-pub fn run(job: &Job, cache: &mut TracerCache, sink: &dyn Fn(Report)) -> Result<(), RenderError> {
+pub fn run(
+    job: &Job,
+    cache: &mut TracerCache,
+    buffers: &mut Buffers,
+    sink: &dyn Fn(Report),
+) -> Result<(), RenderError> {
     let scene = job.scene.as_ref();
     let mut opts = RenderOptions::for_scene(scene);
     opts.image.width = job.width;
@@ -180,10 +247,13 @@ pub fn run(job: &Job, cache: &mut TracerCache, sink: &dyn Fn(Report)) -> Result<
     // The fast tracer comes from the cache; the f64 reference (a `reference` quality)
     // is built for each view.
     match opts.renderer {
-        Renderer::Fast => passes(job, cache.tracer(&job.scene, &opts)?, &opts, sink),
+        Renderer::Fast => {
+            let tracer = cache.tracer(&job.scene, &opts)?;
+            passes(job, tracer, &opts, buffers, sink)
+        }
         Renderer::Reference => {
             let reference = render::make_tracer(scene, &opts)?;
-            passes(job, reference.as_ref(), &opts, sink)
+            passes(job, reference.as_ref(), &opts, buffers, sink)
         }
     }
 }
@@ -194,20 +264,24 @@ fn passes<T: SampleTracer + ?Sized>(
     job: &Job,
     tracer: &T,
     opts: &RenderOptions,
+    buffers: &mut Buffers,
     sink: &dyn Fn(Report),
 ) -> Result<(), RenderError> {
     let control = job.control.as_ref();
     let (w, h) = (job.width, job.height);
     let target = opts.image.spp;
-    let mut sums = vec![Vec3::ZERO; w as usize * h as usize];
     let passes = plan(w, h, target, job.preview_factor);
     let last = passes.len() - 1;
+    buffers.sums.resize(w as usize * h as usize, Vec3::ZERO);
     for (index, pass) in passes.into_iter().enumerate() {
         if control.is_cancelled() {
             return Err(RenderError::Cancelled);
         }
         let start = Instant::now();
-        let (frame, samples, preview, pass_pixels) = match pass {
+        let mut frame = buffers.frames.take().unwrap_or_else(|| Frame::new(0, 0));
+        (frame.width, frame.height) = (w, h);
+        let mut rgba = buffers.rgba.take().unwrap_or_default();
+        let (samples, preview, pass_pixels) = match pass {
             Pass::Preview {
                 width,
                 height,
@@ -219,24 +293,34 @@ fn passes<T: SampleTracer + ?Sized>(
                 small.image.width = width;
                 small.image.height = height;
                 small.image.spp = 1;
-                let mut preview_sums = vec![Vec3::ZERO; width as usize * height as usize];
-                render::accumulate(tracer, &small, 0..1, &mut preview_sums, control)?;
-                let preview = render::resolve(&preview_sums, 1, width, height);
-                let pixels = u64::from(width) * u64::from(height);
-                (upscale(&preview, factor, w, h), 0, true, pixels)
+                let sums = &mut buffers.preview_sums;
+                sums.resize(width as usize * height as usize, Vec3::ZERO);
+                render::accumulate(tracer, &small, 0..1, sums, control)?;
+                let preview = render::resolve(sums, 1, width, height);
+                fill_for_screen(&mut frame, &mut rgba, |j, row| {
+                    upscaled_row(&preview, factor, j, row)
+                });
+                (0, true, u64::from(width) * u64::from(height))
             }
             Pass::Samples(range) => {
                 let end = range.end;
                 let pixels = u64::from(w) * u64::from(h) * range.len() as u64;
-                render::accumulate(tracer, opts, range, &mut sums, control)?;
-                (render::resolve(&sums, end, w, h), end, false, pixels)
+                let sums = &mut buffers.sums;
+                render::accumulate(tracer, opts, range, sums, control)?;
+                let sums = &buffers.sums;
+                fill_for_screen(&mut frame, &mut rgba, |j, row| {
+                    let from = &sums[j * row.len()..(j + 1) * row.len()];
+                    for (p, &sum) in row.iter_mut().zip(from) {
+                        *p = render::pixel_value(sum, end);
+                    }
+                });
+                (end, false, pixels)
             }
         };
-        let rgba = to_rgba_top_down(&frame);
         sink(Report::Frame(Shown {
             generation: job.generation,
-            frame: Arc::new(frame),
-            rgba: Arc::new(rgba),
+            frame: buffers.frames.send(frame),
+            rgba: buffers.rgba.send(rgba),
             samples,
             target,
             preview,
@@ -253,6 +337,7 @@ fn passes<T: SampleTracer + ?Sized>(
 mod tests {
     use super::*;
     use crate::scene::{hw3_scene, HW3_DEFAULT_SEED};
+    use crate::viewer::buffer::{to_rgba_top_down, upscale};
     use std::sync::Mutex;
     use std::time::Duration;
 
@@ -265,16 +350,14 @@ mod tests {
                 Report::Failed { message, .. } => panic!("render failed: {message}"),
             }
         };
-        let job = Job {
-            generation: 7,
-            scene: Arc::new(worker_scene),
-            width: w,
-            height: h,
-            preview_factor: 4,
-            control: Arc::new(RenderControl::default()),
-            submitted: Instant::now(),
-        };
-        run(&job, &mut TracerCache::default(), &sink).unwrap();
+        let job = Job::new(7, Arc::new(worker_scene), (w, h), 4);
+        run(
+            &job,
+            &mut TracerCache::default(),
+            &mut Buffers::default(),
+            &sink,
+        )
+        .unwrap();
         let v = shown.lock().unwrap().clone();
         v
     }
@@ -306,6 +389,49 @@ mod tests {
         render::accumulate(tracer.as_ref(), &opts, 0..1, &mut sums, &Default::default()).unwrap();
         assert_eq!(*shown[1].frame, render::resolve(&sums, 1, w, h));
         assert_eq!(*shown[1].rgba, to_rgba_top_down(&shown[1].frame));
+    }
+
+    #[test]
+    fn reused_buffers_give_the_same_passes_and_spare_what_is_held() {
+        // Every pass of each job, with fresh buffers: what the reused ones must give.
+        let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+        scene.image.spp = 3;
+        let jobs = [(160, 90), (96, 54), (160, 90)];
+        let fresh: Vec<Vec<Shown>> = jobs
+            .iter()
+            .map(|&(w, h)| collect(scene.clone(), w, h))
+            .collect();
+        // The same jobs through one set of buffers; the sink keeps only the first job's
+        // passes (as a window still showing them would), drops the others at once.
+        let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
+        let scene = Arc::new(scene);
+        let held = Mutex::new(Vec::new());
+        for (n, &size) in jobs.iter().enumerate() {
+            let seen = Mutex::new(Vec::new());
+            let sink = |r: Report| match r {
+                Report::Frame(s) => {
+                    let copy = ((*s.frame).clone(), (*s.rgba).clone());
+                    seen.lock().unwrap().push(copy);
+                    if n == 0 {
+                        held.lock().unwrap().push(s);
+                    }
+                }
+                Report::Failed { message, .. } => panic!("render failed: {message}"),
+            };
+            let job = Job::new(n as u64, Arc::clone(&scene), size, 4);
+            run(&job, &mut cache, &mut buffers, &sink).unwrap();
+            let seen = seen.into_inner().unwrap();
+            assert_eq!(seen.len(), fresh[n].len(), "job {n}");
+            for (k, (frame, rgba)) in seen.iter().enumerate() {
+                assert_eq!(*frame, *fresh[n][k].frame, "job {n} pass {k}");
+                assert_eq!(*rgba, *fresh[n][k].rgba, "job {n} pass {k}");
+            }
+        }
+        // The passes the "window" kept were not written over by later jobs.
+        for (k, s) in held.into_inner().unwrap().iter().enumerate() {
+            assert_eq!(*s.frame, *fresh[0][k].frame, "held pass {k}");
+            assert_eq!(*s.rgba, *fresh[0][k].rgba, "held pass {k}");
+        }
     }
 
     #[test]
