@@ -263,3 +263,58 @@ fn sky_runs_see_no_sphere() {
     println!("sky runs: {empty} said empty, {checked} directions checked");
     assert!(empty > 500, "too few empty runs to say anything: {empty}");
 }
+
+/// The tracer's shared cells: when `eye_run` says a row of directions lies in one cell
+/// of the eye grid, the query of each direction with that cell's spheres gives the
+/// per-ray query's hit to the bit (which `culling_never_loses_a_hit_or_an_occluder` checks
+/// against brute force).
+#[test]
+fn rows_in_one_cell_get_the_per_ray_hits() {
+    let counts = RefCell::new((0u64, 0u64, 0u64)); // (runs in one cell, directions, hits)
+    let runs = prop::collection::vec((0.0f64..1.0, unit_vector(), 0.0f64..0.02), 24);
+    runner(150)
+        .run(
+            &(world(), log_uniform(-1.0, 4.0), unit_vector(), runs),
+            |(spheres, eye_dist, eye_dir, runs)| {
+                let eye = eye_dir * eye_dist;
+                let set = Spheres::new(&spheres);
+                let grid = set.eye_grid(eye);
+                let mut c = counts.borrow_mut();
+                for &(pick, across, span) in &runs {
+                    // A row through a random sphere, as the camera forms it.
+                    let s =
+                        &spheres[((pick * spheres.len() as f64) as usize).min(spheres.len() - 1)];
+                    let base = (s.center - eye).normalize_or(across);
+                    let h = across.cross(base).normalize_or(across) * span;
+                    let (corner, h) = ((base - h * 0.5).as_vec3(), h.as_vec3());
+                    let dir = |s: f32| (corner + h * s).normalize();
+                    let Some(run) = set.eye_run(&grid, dir(0.0), dir(1.0)) else {
+                        continue;
+                    };
+                    c.0 += 1;
+                    for step in 0..=8 {
+                        let (a, b) = (dir(step as f32 / 8.0), dir(1.0 - step as f32 / 8.0));
+                        c.1 += 2;
+                        let shared = set.closest_in_run_pair(&grid, &run, a, b);
+                        for (d, got) in [(a, shared[0]), (b, shared[1])] {
+                            let alone = set.closest_from_eye(&grid, d);
+                            let key = |h: Option<whitted::accel::Hit>| {
+                                h.map(|h| (h.sphere, h.point, h.normal, h.entering))
+                            };
+                            prop_assert_eq!(key(got), key(alone));
+                            c.2 += u64::from(got.is_some());
+                            prop_assert!(!run.sees_nothing() || got.is_none());
+                        }
+                    }
+                }
+                Ok(())
+            },
+        )
+        .unwrap_or_else(|e| panic!("{e}\n{:?}", counts.borrow()));
+    let (runs, checked, hits) = counts.into_inner();
+    println!("rows in one cell: {runs} runs, {checked} directions, {hits} hits");
+    assert!(
+        runs > 500 && hits > 2000,
+        "too few to say anything: {runs} runs, {hits} hits"
+    );
+}

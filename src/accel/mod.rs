@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use bvh::{Aabb, Bvh};
 use dirgrid::DirGrid;
-pub use point::{EyeGrid, PointGrid};
+pub use point::{EyeGrid, EyeRun, PointGrid};
 
 use crate::model::Side;
 use crate::scene::Sphere;

@@ -48,10 +48,40 @@ struct EyeStart<'a> {
 impl<'a> EyeStart<'a> {
     #[inline(always)]
     fn new(eye: &'a EyeGrid, d: Vec3) -> Self {
+        EyeStart::in_run(&EyeRun::of_cell(eye, eye.grid.cell(d)), d)
+    }
+
+    /// For a direction of `run`: its cell's list is the run's.
+    #[inline(always)]
+    fn in_run(run: &EyeRun<'a>, d: Vec3) -> Self {
         EyeStart {
             d64: d.as_dvec3().normalize(),
-            candidates: eye.grid.candidates(eye.grid.cell(d)),
+            candidates: run.candidates,
         }
+    }
+}
+
+/// Directions from the eye that share one cell of its grid, such as the pixels of a
+/// row between two that fall in one cell (see [`Spheres::eye_run`]): one cell lookup
+/// serves them all.
+#[derive(Clone, Copy)]
+pub struct EyeRun<'a> {
+    /// The cell's spheres, nearest first.
+    candidates: &'a [(u32, f32)],
+}
+
+impl<'a> EyeRun<'a> {
+    #[inline(always)]
+    fn of_cell(eye: &'a EyeGrid, cell: usize) -> Self {
+        EyeRun {
+            candidates: eye.grid.candidates(cell),
+        }
+    }
+
+    /// No direction of the run meets a sphere: they all see the sky.
+    #[inline]
+    pub fn sees_nothing(&self) -> bool {
+        self.candidates.is_empty()
     }
 }
 
@@ -220,6 +250,39 @@ impl Spheres {
         ]
     }
 
+    /// [`Spheres::closest_from_eye_pair`] of two directions of `run` (from
+    /// [`Spheres::eye_run`] of this grid): the same hits, without a cell lookup each.
+    pub fn closest_in_run_pair(
+        &self,
+        eye: &EyeGrid,
+        run: &EyeRun<'_>,
+        a: Vec3,
+        b: Vec3,
+    ) -> [Option<Hit>; 2] {
+        let (start_a, start_b) = (EyeStart::in_run(run, a), EyeStart::in_run(run, b));
+        [
+            self.closest_from_start(eye, a, start_a),
+            self.closest_from_start(eye, b, start_b),
+        ]
+    }
+
+    /// When every direction from the eye between `a` and `b` (unit vectors; the
+    /// directions of one image row between two pixels, say) lies in one cell of the
+    /// eye grid, that cell, for [`Spheres::closest_in_run_pair`]: so when `a` and `b`
+    /// fall in one cell (a cell is a square in its face's plane, and the row's
+    /// directions between project to the segment between, inside it; cells list every
+    /// sphere seen within a widened cone, which covers the rounding of the directions
+    /// many times over) and the eye is inside no sphere.
+    #[inline]
+    pub fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
+        let grid = &eye.grid;
+        let cell = grid.cell(a);
+        // An eye grid (its per-sphere records: even with no sphere) with the eye
+        // inside no sphere.
+        let shortcut = grid.always.is_empty() && eye.exact.len() == self.len();
+        (shortcut && cell == grid.cell(b)).then(|| EyeRun::of_cell(eye, cell))
+    }
+
     #[inline(always)]
     fn closest_from_start(&self, eye: &EyeGrid, d: Vec3, start: EyeStart<'_>) -> Option<Hit> {
         let d64 = start.d64;
@@ -258,16 +321,11 @@ impl Spheres {
         self.finish(best)
     }
 
-    /// `true` when no ray from the eye with a direction between `a` and `b` (unit
-    /// vectors; the directions of one image row between two pixels, say) can meet a
-    /// sphere. So when `a` and `b` fall in one empty cell of the eye grid: a cell is a
-    /// square in its face's plane, the rows' directions between project to the segment
-    /// between, inside it; and cells list every sphere seen within a widened cone,
-    /// which covers the rounding of the directions many times over.
+    /// `true` when no ray from the eye with a direction between `a` and `b` can meet a
+    /// sphere: their [`Spheres::eye_run`] is an empty cell.
     pub fn eye_sees_nothing_between(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> bool {
-        let grid = &eye.grid;
-        let cell = grid.cell(a);
-        grid.always.is_empty() && cell == grid.cell(b) && grid.candidates(cell).is_empty()
+        self.eye_run(eye, a, b)
+            .is_some_and(|run| run.sees_nothing())
     }
 
     /// The shadow factor along the segment of length `dist` towards light `light`.

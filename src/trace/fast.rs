@@ -301,18 +301,18 @@ impl SampleTracer for FastTracer {
     fn sample_row(&self, s: &[f32], t: f32, out: &mut [Vec3], counts: &mut RayCounts) {
         let dir =
             |s: f32| model::primary_direction(self.corner, self.horizontal, self.vertical, s, t);
-        // Runs of a few samples whose end directions fall in one empty cell of the eye
-        // grid see only sky (`Spheres::eye_sees_nothing_between`): their colours are
-        // the sky's, as `trace` would return them, without the per-ray query.
+        // Runs of a few samples whose end directions fall in one cell of the eye grid
+        // share that cell's spheres (`Spheres::eye_run`): an empty cell means sky, as
+        // `trace` would return it, without the per-ray query; else one cell lookup
+        // serves the run.
         const RUN: usize = 8;
+        let spheres = &self.compiled.spheres;
         for (s, out) in s.chunks(RUN).zip(out.chunks_mut(RUN)) {
             let (first, last) = (dir(s[0]), dir(s[s.len() - 1]));
-            if self.max_depth > 0
-                && self
-                    .compiled
-                    .spheres
-                    .eye_sees_nothing_between(&self.eye, first, last)
-            {
+            let run = (self.max_depth > 0)
+                .then(|| spheres.eye_run(&self.eye, first, last))
+                .flatten();
+            if run.is_some_and(|r| r.sees_nothing()) {
                 for (o, &s) in out.iter_mut().zip(s) {
                     *o = model::sky(dir(s), self.compiled.sky_down, self.compiled.sky_up);
                 }
@@ -320,11 +320,13 @@ impl SampleTracer for FastTracer {
             } else if self.max_depth > 0 && self.cutoff == 0.0 {
                 // Two rays at a time through the eye query (see
                 // `Spheres::closest_from_eye_pair`), then shaded one by one, as `trace`.
-                let spheres = &self.compiled.spheres;
                 let mut skipped = Skipped::default();
                 for (o, s) in out.chunks_mut(2).zip(s.chunks(2)) {
                     let (a, b) = (dir(s[0]), dir(s[s.len() - 1]));
-                    let [hit_a, hit_b] = spheres.closest_from_eye_pair(&self.eye, a, b);
+                    let [hit_a, hit_b] = match &run {
+                        Some(run) => spheres.closest_in_run_pair(&self.eye, run, a, b),
+                        None => spheres.closest_from_eye_pair(&self.eye, a, b),
+                    };
                     if o.len() == 2 {
                         counts.primary += 2;
                         [o[0], o[1]] = self.shade_pair([(a, hit_a), (b, hit_b)], counts);
