@@ -66,12 +66,31 @@ fn bad_scene_files_exit_1_naming_the_place() {
     assert_fails_with(&out, &["unknown.toml:4:1", "shine"]);
     assert_eq!(entries(dir.path()), ["unknown.toml"], "no image written");
 
-    // A wrong type: the value's line and column.
+    // A wrong type: the value's line and column, the field, in the file's words.
     let (_, out) = render_scene(
         "type.toml",
         "[[sphere]]\ncenter = [0, 0, -1]\nradius = \"big\"\n",
     );
-    assert_fails_with(&out, &["type.toml:3:10", "big"]);
+    assert_fails_with(
+        &out,
+        &["type.toml:3:10: sphere 1: radius: expected a number, got the string \"big\""],
+    );
+    let (_, out) = render_scene(
+        "int.toml",
+        "[image]\nspp = 2.5\n\n[[light]]\nposition = [1, 2]\n",
+    );
+    assert_fails_with(
+        &out,
+        &["int.toml:2:7: image.spp: expected a whole number, got 2.5"],
+    );
+    let (_, out) = render_scene(
+        "length.toml",
+        "[[light]]\nposition = [1, 2]\n\n[[light]]\nposition = [1, 2, 3, 4]\n",
+    );
+    assert_fails_with(
+        &out,
+        &["length.toml:2:12: light 1: position: expected an array of 3 numbers, got 2 values"],
+    );
 
     // A NaN radius (TOML `nan`): the place and the field.
     let (_, out) = render_scene(

@@ -264,9 +264,85 @@ pub(super) fn parse_whole(text: &str, path: &str) -> Result<Scene, SceneError> {
 fn from_toml<T: serde::de::DeserializeOwned>(text: &str, at: &Locator) -> Result<T, SceneError> {
     toml::from_str(text).map_err(|e| {
         let message = e.message().trim().replace('\n', " ");
-        match e.span() {
-            Some(span) => at.at(span, message),
-            None => at.whole(message),
+        match (e.span(), plain_type_error(&message)) {
+            // A value of the wrong type or length: named by its field, as the
+            // validation messages name theirs.
+            (Some(span), Some(plain)) => {
+                let message = match field_at(at.text, span.start + at.offset) {
+                    Some(field) => format!("{field}: {plain}"),
+                    None => plain,
+                };
+                at.at(span, message)
+            }
+            (Some(span), None) => at.at(span, message),
+            (None, plain) => at.whole(plain.unwrap_or(message)),
+        }
+    })
+}
+
+/// serde's wording of a wrong type or length in the words of a scene file: "invalid
+/// type: string \"big\", expected f64" becomes "expected a number, got the string
+/// \"big\"". `None` for other messages.
+fn plain_type_error(message: &str) -> Option<String> {
+    let (got, expected) = if let Some(rest) = message.strip_prefix("invalid type: ") {
+        let (got, expected) = rest.split_once(", expected ")?;
+        let got = if let Some(text) = got.strip_prefix("string ") {
+            format!("the string {text}")
+        } else if let Some((_, value)) = got.split_once(" `") {
+            value.trim_end_matches('`').to_string() // integer `3`, boolean `true`
+        } else {
+            match got {
+                "sequence" => "an array".into(),
+                "map" => "a table".into(),
+                other => other.into(),
+            }
+        };
+        (got, expected)
+    } else if let Some(rest) = message.strip_prefix("invalid length ") {
+        let (n, expected) = rest.split_once(", expected ")?;
+        (format!("{n} values"), expected)
+    } else {
+        return None;
+    };
+    let expected = match expected {
+        "f64" | "f32" => "a number",
+        "i64" | "u64" | "i32" | "u32" => "a whole number",
+        "an array of length 3" => "an array of 3 numbers",
+        other => other,
+    };
+    Some(format!("expected {expected}, got {got}"))
+}
+
+/// The field whose value starts at byte `offset` of the scene text, named as the
+/// validation messages name fields ("sphere 2: radius", "image.width"): the key of the
+/// line (when the value follows its `=`) under the table header above it.
+fn field_at(text: &str, offset: usize) -> Option<String> {
+    let offset = text.floor_char_boundary_compat(offset.min(text.len()));
+    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    let (key, _) = text[line_start..offset].split_once('=')?;
+    let key = key.trim();
+    if key.is_empty() || key.starts_with('[') || key.contains(['#', '"', '\'']) {
+        return None;
+    }
+    let before = &text[..line_start];
+    let header = before
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find(|l| l.starts_with('['));
+    Some(match header {
+        None => key.to_string(),
+        Some(h) if h.starts_with("[[") => {
+            let table = h.trim_start_matches('[').split(']').next()?.trim();
+            let index = before
+                .lines()
+                .filter(|l| l.trim_start().starts_with("[[") && l.contains(table))
+                .count();
+            format!("{table} {index}: {key}")
+        }
+        Some(h) => {
+            let table = h.trim_start_matches('[').split(']').next()?.trim();
+            format!("{table}.{key}")
         }
     })
 }
@@ -697,4 +773,52 @@ fn camera(at: &Locator, c: &Spanned<FileCamera>) -> Result<CameraSpec, SceneErro
     };
     crate::camera::check_spec(&spec).map_err(|m| at.at(c.span(), format!("camera: {m}")))?;
     Ok(spec)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn type_errors_read_in_the_words_of_a_scene_file() {
+        for (serde, plain) in [
+            (
+                "invalid type: string \"big\", expected f64",
+                "expected a number, got the string \"big\"",
+            ),
+            (
+                "invalid type: floating point `1.5`, expected i64",
+                "expected a whole number, got 1.5",
+            ),
+            (
+                "invalid type: boolean `true`, expected f64",
+                "expected a number, got true",
+            ),
+            (
+                "invalid type: sequence, expected f64",
+                "expected a number, got an array",
+            ),
+            (
+                "invalid length 2, expected an array of length 3",
+                "expected an array of 3 numbers, got 2 values",
+            ),
+        ] {
+            assert_eq!(plain_type_error(serde).as_deref(), Some(plain));
+        }
+        assert_eq!(plain_type_error("unknown field `shine`"), None);
+    }
+
+    #[test]
+    fn fields_are_named_by_their_table_and_key() {
+        let text =
+            "seed = 1\n[image]\nwidth = x\n[[sphere]]\nradius = 1\n\n[[sphere]]\n  radius = y\n";
+        let at = |needle: &str| field_at(text, text.find(needle).unwrap());
+        assert_eq!(at("1\n[image]").as_deref(), Some("seed"));
+        assert_eq!(at("x").as_deref(), Some("image.width"));
+        assert_eq!(at("1\n\n").as_deref(), Some("sphere 1: radius"));
+        assert_eq!(at("y").as_deref(), Some("sphere 2: radius"));
+        // On a header or a key itself there is no value to name.
+        assert_eq!(at("[image]"), None);
+        assert_eq!(at("width"), None);
+    }
 }
