@@ -462,9 +462,48 @@ impl Best {
 #[inline(always)]
 fn round_up(t: f64) -> f32 {
     let f = t as f32;
-    if f64::from(f) < t {
+    if t >= 0.0 {
+        // The queries' distances: one step up is one more in the bits (of +0 the least
+        // subnormal, of f32::MAX infinity), added without a branch: whether the cast
+        // rounded down is a coin toss, and a mispredicted branch cost more than this.
+        f32::from_bits(f.to_bits() + u32::from(f64::from(f) < t))
+    } else if f64::from(f) < t {
         f.next_up()
     } else {
         f
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_up;
+
+    #[test]
+    fn round_up_is_the_least_f32_not_below() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1e-300,
+            f64::from(f32::MAX),
+            f64::from(f32::MAX) * (1.0 + 1e-12),
+            1e300,
+            f64::INFINITY,
+            -1e-300,
+            -1.5,
+            -f64::from(f32::MAX) * (1.0 + 1e-12),
+        ];
+        // Values between, on and beside f32s of every magnitude.
+        for e in -140..=127 {
+            let f = 2f64.powi(e) * 1.2345;
+            let f32_near = f64::from(f as f32);
+            values.extend([f, -f, f32_near, f32_near.next_up(), f32_near.next_down()]);
+        }
+        for t in values {
+            let up = round_up(t);
+            let f = t as f32;
+            let want = if f64::from(f) < t { f.next_up() } else { f };
+            assert_eq!(up.to_bits(), want.to_bits(), "t = {t:e}");
+            assert!(f64::from(up) >= t, "t = {t:e}");
+        }
     }
 }
