@@ -430,14 +430,14 @@ fn may_cross(c: DVec3, w: f32, ray: &Ray, t_max: f32) -> bool {
     let ff = f.dot(f);
     let slack = QUICK_SLACK * (rr + ff);
     let ll = l.dot(l);
-    if ll > rr + slack {
-        return false;
-    }
     // The crossings lie in [bp − h, bp + h] with h the half chord, up to rounding; the
     // slack keeps this h above the true one. (With h = r, a ray leaving a huge sphere's
-    // outside — up from the ground — passed and cost an exact test.)
+    // outside — up from the ground — passed and cost an exact test.) A line that
+    // passes too far gives h = NaN, and fails every comparison; `&`, not `&&`: one
+    // branch on the outcome (an early return on the first test was mispredicted
+    // often enough to cost more than the square roots).
     let reach = (rr + slack - ll).sqrt() + QUICK_SLACK * (ff.sqrt() + w);
-    bp + reach > 0.0 && bp - reach < t_max
+    (ll <= rr + slack) & (bp + reach > 0.0) & (bp - reach < t_max)
 }
 
 /// The closest crossing found so far.

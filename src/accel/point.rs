@@ -144,7 +144,8 @@ impl PointQuick {
     #[inline(always)]
     fn may_cross(&self, d: Vec3, t_max: f32) -> bool {
         let bp = -self.f.dot(d);
-        bp * bp >= self.min_bp2 && bp + self.reach > 0.0 && bp - self.reach < t_max
+        // `&`, not `&&`: one branch on the outcome, not three on its parts.
+        (bp * bp >= self.min_bp2) & (bp + self.reach > 0.0) & (bp - self.reach < t_max)
     }
 
     /// [`PointQuick::may_cross`] for a ray whose line may pass up to `offset` from the
@@ -153,9 +154,9 @@ impl PointQuick {
     fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
         let bp = -self.f.dot(d);
         let reach = self.reach + offset;
-        bp * bp + offset * (2.0 * self.radius + offset) >= self.min_bp2
-            && bp + reach > 0.0
-            && bp - reach < t_max
+        (bp * bp + offset * (2.0 * self.radius + offset) >= self.min_bp2)
+            & (bp + reach > 0.0)
+            & (bp - reach < t_max)
     }
 }
 
