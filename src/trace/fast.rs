@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use glam::{DVec3, Vec3};
 
+use super::row::{self, RowCamera, RUN};
 use super::{RayCounts, SampleTracer};
 use crate::accel::{EyeGrid, Hit, Query, Spheres};
 use crate::camera::Camera;
@@ -299,30 +300,29 @@ impl SampleTracer for FastTracer {
     }
 
     fn sample_row(&self, s: &[f32], t: f32, out: &mut [Vec3], counts: &mut RayCounts) {
-        let dir =
-            |s: f32| model::primary_direction(self.corner, self.horizontal, self.vertical, s, t);
+        let camera = RowCamera::new(self.corner, self.horizontal, self.vertical, t);
         // Runs of a few samples whose end directions fall in one cell of the eye grid
         // share that cell's spheres (`Spheres::eye_run`): an empty cell means sky, as
         // `trace` would return it, without the per-ray query; else one cell lookup
         // serves the run.
-        const RUN: usize = 8;
         let spheres = &self.compiled.spheres;
+        let mut dirs = [Vec3::ZERO; RUN];
         for (s, out) in s.chunks(RUN).zip(out.chunks_mut(RUN)) {
-            let (first, last) = (dir(s[0]), dir(s[s.len() - 1]));
+            camera.directions(s, &mut dirs);
+            let dirs = &dirs;
+            let (first, last) = (dirs[0], dirs[s.len() - 1]);
             let run = (self.max_depth > 0)
                 .then(|| spheres.eye_run(&self.eye, first, last))
                 .flatten();
             if run.is_some_and(|r| r.sees_nothing()) {
-                for (o, &s) in out.iter_mut().zip(s) {
-                    *o = model::sky(dir(s), self.compiled.sky_down, self.compiled.sky_up);
-                }
+                row::sky(dirs, self.compiled.sky_down, self.compiled.sky_up, out);
                 counts.primary += s.len() as u64;
             } else if self.max_depth > 0 && self.cutoff == 0.0 {
                 // Two rays at a time through the eye query (see
                 // `Spheres::closest_from_eye_pair`), then shaded one by one, as `trace`.
                 let mut skipped = Skipped::default();
-                for (o, s) in out.chunks_mut(2).zip(s.chunks(2)) {
-                    let (a, b) = (dir(s[0]), dir(s[s.len() - 1]));
+                for (o, d) in out.chunks_mut(2).zip(dirs.chunks(2)) {
+                    let (a, b) = (d[0], d[o.len() - 1]);
                     let [hit_a, hit_b] = match &run {
                         Some(run) => spheres.closest_in_run_pair(&self.eye, run, a, b),
                         None => spheres.closest_from_eye_pair(&self.eye, a, b),

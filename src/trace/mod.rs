@@ -5,6 +5,7 @@
 pub mod fast;
 pub mod intersect;
 pub mod reference;
+mod row;
 
 use glam::Vec3;
 
