@@ -110,6 +110,8 @@ struct PointQuick {
     min_bp2: f32,
     /// The (widened) radius plus slack: the crossings lie within `reach` of `−f·d`.
     reach: f32,
+    /// The slack of `−f·d` itself: the crossings lie within the half chord plus this.
+    tail: f32,
     /// The widened radius.
     radius: f32,
 }
@@ -131,10 +133,12 @@ impl PointQuick {
             rounded
         };
         let ff = f.dot(f);
+        let tail = QUICK_SLACK * (ff.sqrt() + quick.w);
         PointQuick {
             f,
             min_bp2,
-            reach: quick.w + QUICK_SLACK * (ff.sqrt() + quick.w),
+            reach: quick.w + tail,
+            tail,
             radius: quick.w,
         }
     }
@@ -149,14 +153,18 @@ impl PointQuick {
     }
 
     /// [`PointQuick::may_cross`] for a ray whose line may pass up to `offset` from the
-    /// point (the sphere is widened by `offset`).
+    /// point (the sphere is widened by `offset`), bounding the crossings by the half
+    /// chord rather than the radius: `bp² − min_bp2` is the widened sphere's squared
+    /// half chord plus the slack. (Shadow rays: with the radius, 77% of the spheres
+    /// that passed in many_100000 were not crossed by the segment, most of them lying
+    /// just beyond the hit point.)
     #[inline(always)]
     fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
         let bp = -self.f.dot(d);
-        let reach = self.reach + offset;
-        (bp * bp + offset * (2.0 * self.radius + offset) >= self.min_bp2)
-            & (bp + reach > 0.0)
-            & (bp - reach < t_max)
+        let chord2 = bp * bp + offset * (2.0 * self.radius + offset) - self.min_bp2;
+        // NaN when the line misses (chord2 < 0): it fails every comparison.
+        let reach = chord2.sqrt() + self.tail + offset;
+        (chord2 >= 0.0) & (bp + reach > 0.0) & (bp - reach < t_max)
     }
 }
 
