@@ -160,6 +160,11 @@ pub struct Branches {
 }
 
 impl Branches {
+    /// Only the local term: a diffuse surface.
+    pub fn only_local(&self) -> bool {
+        self.local && !self.reflect && !self.transmit
+    }
+
     pub fn of(w_r: f64, w_t: f64) -> Self {
         Branches {
             local: (1.0 - w_t) * (1.0 - w_r) != 0.0,

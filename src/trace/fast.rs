@@ -20,6 +20,9 @@ struct Material {
     w_t: f32,
     ior: f32,
     branches: Branches,
+    /// Diffuse only (local shading, no reflection nor transmission): one flag, not
+    /// three tests, where a pair of hits is classified.
+    only_local: bool,
 }
 
 #[derive(Clone, Copy)]
@@ -74,6 +77,7 @@ impl FastTracer {
                     w_t: s.transmit as f32,
                     ior: s.ior as f32,
                     branches: Branches::of(s.reflect, s.transmit),
+                    only_local: Branches::of(s.reflect, s.transmit).only_local(),
                 })
                 .collect(),
             lights: scene
@@ -204,7 +208,7 @@ impl FastTracer {
                 }
             }
         }
-        if !m.branches.reflect && !m.branches.transmit {
+        if m.only_local {
             // A diffuse surface: step 7 mixes `local` with weights 1 and 0, which gives
             // `local` exactly.
             return local;
@@ -244,7 +248,7 @@ impl FastTracer {
         let diffuse = |hit: Option<Hit>| {
             let h = hit?;
             let m = &c.materials[h.sphere as usize];
-            (m.branches.local && !m.branches.reflect && !m.branches.transmit).then_some((h, m))
+            m.only_local.then_some((h, m))
         };
         let (Some((ha, ma)), Some((hb, mb)), [light]) =
             (diffuse(rays[0].1), diffuse(rays[1].1), c.lights.as_slice())
