@@ -513,6 +513,45 @@ fn without_a_gpu_adapter_it_falls_back_to_softbuffer() {
     assert!(status.success());
 }
 
+/// Left to choose, the viewer draws with `pixels` on a GPU only: where wgpu's only
+/// adapter is a CPU rasterizer (lavapipe, as on CI), with `softbuffer`, and says why.
+#[test]
+fn the_automatic_blitter_uses_pixels_on_a_gpu_only() {
+    if !x_tools_or_skip("automatic blitter test") {
+        return;
+    }
+    let x = XServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let scene = small_scene(dir, 1);
+    let expected = headless(dir, &scene, &[], "render.png");
+    let (mut viewer, window) = start_viewer_with(&x, dir, &scene, &[("WHITTED_BLIT", "")]);
+    x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
+    let stderr = viewer.stderr();
+    if stderr.contains("stats: blitter pixels\n") {
+        let adapter = stderr
+            .lines()
+            .find_map(|l| l.strip_prefix("stats: adapter "))
+            .unwrap_or_else(|| panic!("no adapter named: {stderr}"));
+        assert!(!adapter.ends_with("(Cpu)"), "pixels on a CPU: {stderr}");
+    } else {
+        assert!(
+            stderr.contains("stats: blitter softbuffer\n")
+                && stderr.contains("drawing with softbuffer instead"),
+            "{stderr}"
+        );
+        println!(
+            "automatic blitter: {}",
+            stderr.lines().find(|l| l.contains("instead")).unwrap()
+        );
+    }
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(diff, 0, "{diff} pixels differ from `whitted render`");
+    x.key(&window, "q");
+    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
+    assert!(status.success());
+}
+
 #[test]
 fn without_a_display_it_says_so_and_exits_1() {
     let out = Command::new(BIN)

@@ -348,6 +348,9 @@ impl App {
             self.first_frame_reported = true;
             let blitter = self.blitter.as_ref().map_or("none", Blitter::name);
             eprintln!("stats: blitter {blitter}");
+            if let Some(adapter) = self.blitter.as_ref().and_then(Blitter::adapter) {
+                eprintln!("stats: adapter {adapter}");
+            }
         }
     }
 }
