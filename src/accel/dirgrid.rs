@@ -7,6 +7,7 @@
 //! sees every sphere it could hit: the grid changes the work, never the answer.
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 pub struct DirGrid {
     /// The point every ray of the grid passes through.
@@ -21,6 +22,43 @@ pub struct DirGrid {
     items: Vec<(u32, f32)>,
     /// Spheres that contain the centre: seen in every direction.
     pub always: Vec<u32>,
+}
+
+/// Spheres a unit of parallel work of the build: enough to outweigh its overhead.
+const SPHERES_PER_RUN: usize = 2048;
+
+/// What a run of spheres adds to a grid.
+#[derive(Default)]
+struct Run {
+    /// Spheres that contain the centre.
+    always: Vec<u32>,
+    /// (cell, sphere) for every cell a sphere is seen in.
+    pairs: Vec<(u32, u32)>,
+}
+
+/// The cells around `centre` in which sphere `k` (`c`, `r`) is seen, into `out`.
+fn cells_of(centre: DVec3, c: DVec3, r: f64, n: u32, cones: &CellCones, k: u32, out: &mut Run) {
+    let rel = c - centre;
+    let reach = r * (1.0 + 1e-6) + 1e-9 * rel.abs().max_element();
+    let dist = rel.length();
+    if dist <= reach {
+        out.always.push(k);
+        return;
+    }
+    let sphere_cone = SphereCone::new(rel, dist, r);
+    let (lo, hi) = (rel - DVec3::splat(reach), rel + DVec3::splat(reach));
+    for face in 0..6u32 {
+        let Some([u0, u1, v0, v1]) = face_rect(face, lo, hi, n) else {
+            continue;
+        };
+        for v in v0..=v1 {
+            for u in u0..=u1 {
+                if cones.meets(face, u, v, &sphere_cone) {
+                    out.pairs.push((cell_index(face, u, v, n) as u32, k));
+                }
+            }
+        }
+    }
 }
 
 /// Widening of each sphere's range in face coordinates (cells are `2/n` wide): covers
@@ -52,50 +90,35 @@ impl DirGrid {
         order.sort_unstable_by(|&a, &b| near_of[a as usize].total_cmp(&near_of[b as usize]));
 
         let cones = CellCones::shared(n);
-        let mut always = Vec::new();
-        let mut pairs: Vec<(u32, u32)> = Vec::new(); // (cell, sphere)
-        for &k in &order {
-            let (c, r) = spheres[k as usize];
-            let rel = c - centre;
-            let reach = r * (1.0 + 1e-6) + 1e-9 * rel.abs().max_element();
-            let dist = rel.length();
-            if dist <= reach {
-                always.push(k);
-                continue;
-            }
-            let sphere_cone = SphereCone::new(rel, dist, r);
-            let (lo, hi) = (rel - DVec3::splat(reach), rel + DVec3::splat(reach));
-            for face in 0..6u32 {
-                let Some([u0, u1, v0, v1]) = face_rect(face, lo, hi, n) else {
-                    continue;
-                };
-                for v in v0..=v1 {
-                    for u in u0..=u1 {
-                        if cones.meets(face, u, v, &sphere_cone) {
-                            pairs.push((cell_index(face, u, v, n) as u32, k));
-                        }
-                    }
+        // Each sphere's cells, in runs of spheres on rayon's threads; the runs come
+        // back in order, so the pairs stay nearest first.
+        let runs: Vec<Run> = order
+            .par_chunks(SPHERES_PER_RUN)
+            .map(|run| {
+                let mut out = Run::default();
+                for &k in run {
+                    let (c, r) = spheres[k as usize];
+                    cells_of(centre, c, r, n, &cones, k, &mut out);
                 }
-            }
-        }
-        // Counting sort by cell (stable: keeps the nearest-first order).
+                out
+            })
+            .collect();
+        // Counting sort by cell (stable: keeps the nearest-first order), writing each
+        // entry with its nearest distance straight into place.
         let mut offsets = vec![0u32; faces + 1];
-        for &(cell, _) in &pairs {
+        for &(cell, _) in runs.iter().flat_map(|run| &run.pairs) {
             offsets[cell as usize + 1] += 1;
         }
         for c in 0..faces {
             offsets[c + 1] += offsets[c];
         }
         let mut fill = offsets.clone();
-        let mut items = vec![0u32; pairs.len()];
-        for &(cell, k) in &pairs {
-            items[fill[cell as usize] as usize] = k;
+        let mut items = vec![(0u32, 0.0f32); offsets[faces] as usize];
+        for &(cell, k) in runs.iter().flat_map(|run| &run.pairs) {
+            items[fill[cell as usize] as usize] = (k, near_of[k as usize]);
             fill[cell as usize] += 1;
         }
-        let items = items
-            .into_iter()
-            .map(|k| (k, near_of[k as usize]))
-            .collect();
+        let always = runs.into_iter().flat_map(|run| run.always).collect();
         DirGrid {
             centre,
             n,
