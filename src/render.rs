@@ -352,10 +352,10 @@ fn film(opts: &RenderOptions, i: u32, j: u32, k: u32) -> (f32, f32) {
     )
 }
 
-/// Adds samples `samples` of every pixel of the area into `sums` (area-sized, row 0 at
-/// the bottom of the area), in sample order, so that any split into passes sums the
-/// same numbers in the same order. A range from sample 0 starts the sums afresh
-/// (whatever `sums` held), so a reused buffer needs no clearing.
+/// Sums samples `samples` of every pixel of the area into `sums` (area-sized, row 0 at
+/// the bottom of the area): added to what it holds, or, for a range from sample 0,
+/// from scratch (so a reused buffer needs no clearing). In sample order, so that any
+/// split into passes sums the same numbers in the same order.
 pub fn accumulate<T: SampleTracer + ?Sized>(
     tracer: &T,
     opts: &RenderOptions,

@@ -143,7 +143,7 @@ pub fn time_orbit(
     views: usize,
 ) -> Result<OrbitTiming, RenderError> {
     use crate::viewer::controls::{Action, CameraControl};
-    use crate::viewer::schedule::preview_factor;
+    use crate::viewer::schedule::{measured_speed, preview_factor};
     use crate::viewer::worker::{self, Buffers, Job, Report, TracerCache};
     use std::sync::Arc;
     use std::time::Instant;
@@ -186,9 +186,7 @@ pub fn time_orbit(
             }
         }
         for s in &shown {
-            if s.pass_seconds > 0.0 {
-                speed = s.pass_pixels as f64 / s.pass_seconds;
-            }
+            speed = measured_speed(s.samples, s.pass_pixels, s.pass_seconds).unwrap_or(speed);
         }
         if view == 0 {
             start = Instant::now(); // the warm-up view: thread pool, caches

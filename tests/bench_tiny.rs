@@ -48,15 +48,18 @@ fn tiny_study_writes_a_complete_csv_table_and_plot() {
             "{}",
             s.name
         );
-        // The fastest setting is on the front by definition.
-        let fastest = these
-            .iter()
-            .min_by(|a, b| {
-                let t = |r: &Vec<&str>| r[col("median_s")].parse::<f64>().unwrap();
-                t(a).total_cmp(&t(b))
-            })
-            .unwrap();
-        assert_eq!(fastest[col("pareto")], "true");
+        // The fastest setting is on the front by definition. The CSV rounds times to
+        // microseconds, where tiny renders can tie: one of the tied is the fastest.
+        let t = |r: &Vec<&str>| r[col("median_s")].parse::<f64>().unwrap();
+        let fastest = these.iter().map(|r| t(r)).fold(f64::INFINITY, f64::min);
+        assert!(
+            these
+                .iter()
+                .filter(|r| t(r) == fastest)
+                .any(|r| r[col("pareto")] == "true"),
+            "{}: no setting of the least time ({fastest} s) is on the front",
+            s.name
+        );
         let reference = these
             .iter()
             .find(|r| r[col("preset")] == "reference")

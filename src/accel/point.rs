@@ -21,10 +21,12 @@ pub struct PointGrid {
 }
 
 impl PointGrid {
-    /// Whether [`Spheres::closest_from_eye`] may use its shortcut: an eye grid, and the
-    /// eye inside no sphere (else the general query runs).
-    fn eye_shortcut_applies(&self) -> bool {
-        self.grid.always.is_empty() && !self.exact.is_empty()
+    /// Whether the eye's shortcuts ([`Spheres::closest_from_eye`], [`Spheres::eye_run`])
+    /// apply to a scene of `spheres` spheres: an eye grid (with the per-sphere records,
+    /// even when there is no sphere), and the eye inside no sphere (else the general
+    /// query runs).
+    fn eye_shortcut_applies(&self, spheres: usize) -> bool {
+        self.grid.always.is_empty() && self.exact.len() == spheres
     }
 
     fn query(&self, d: Vec3) -> Query {
@@ -235,7 +237,7 @@ impl Spheres {
     /// [`Spheres::closest_primary`] for the ray from the eye with unit direction `d`,
     /// with the origin's part of every test worked out beforehand (same results).
     pub fn closest_from_eye(&self, eye: &EyeGrid, d: Vec3) -> Option<Hit> {
-        if !eye.eye_shortcut_applies() {
+        if !eye.eye_shortcut_applies(self.len()) {
             return self.closest_primary(eye, &eye.query(d));
         }
         let start = EyeStart::new(eye, d);
@@ -246,7 +248,7 @@ impl Spheres {
     /// of long-latency steps (square roots, divisions, dependent loads); set side by
     /// side, the processor overlaps the two chains.
     pub fn closest_from_eye_pair(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> [Option<Hit>; 2] {
-        if !eye.eye_shortcut_applies() {
+        if !eye.eye_shortcut_applies(self.len()) {
             return [
                 self.closest_primary(eye, &eye.query(a)),
                 self.closest_primary(eye, &eye.query(b)),
@@ -286,9 +288,7 @@ impl Spheres {
     pub fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
         let grid = &eye.grid;
         let cell = grid.cell(a);
-        // An eye grid (its per-sphere records: even with no sphere) with the eye
-        // inside no sphere.
-        let shortcut = grid.always.is_empty() && eye.exact.len() == self.len();
+        let shortcut = eye.eye_shortcut_applies(self.len());
         (shortcut && cell == grid.cell(b)).then(|| EyeRun::of_cell(eye, cell))
     }
 

@@ -268,7 +268,7 @@ fn from_toml<T: serde::de::DeserializeOwned>(text: &str, at: &Locator) -> Result
             // A value of the wrong type or length: named by its field, as the
             // validation messages name theirs.
             (Some(span), Some(plain)) => {
-                let message = match field_at(at.text, span.start + at.offset) {
+                let message = match field_at(at.text, span.start.saturating_add(at.offset)) {
                     Some(field) => format!("{field}: {plain}"),
                     None => plain,
                 };
@@ -285,7 +285,8 @@ fn from_toml<T: serde::de::DeserializeOwned>(text: &str, at: &Locator) -> Result
 /// \"big\"". `None` for other messages.
 fn plain_type_error(message: &str) -> Option<String> {
     let (got, expected) = if let Some(rest) = message.strip_prefix("invalid type: ") {
-        let (got, expected) = rest.split_once(", expected ")?;
+        // The last ", expected ": a string value may hold those words itself.
+        let (got, expected) = rest.rsplit_once(", expected ")?;
         let got = if let Some(text) = got.strip_prefix("string ") {
             format!("the string {text}")
         } else if let Some((_, value)) = got.split_once(" `") {
@@ -299,7 +300,7 @@ fn plain_type_error(message: &str) -> Option<String> {
         };
         (got, expected)
     } else if let Some(rest) = message.strip_prefix("invalid length ") {
-        let (n, expected) = rest.split_once(", expected ")?;
+        let (n, expected) = rest.rsplit_once(", expected ")?;
         (format!("{n} values"), expected)
     } else {
         return None;
@@ -308,6 +309,8 @@ fn plain_type_error(message: &str) -> Option<String> {
         "f64" | "f32" => "a number",
         "i64" | "u64" | "i32" | "u32" => "a whole number",
         "an array of length 3" => "an array of 3 numbers",
+        // The loader's own types ("struct FileImage") are tables in the file.
+        other if other.starts_with("struct ") => "a table",
         other => other,
     };
     Some(format!("expected {expected}, got {got}"))
@@ -315,35 +318,36 @@ fn plain_type_error(message: &str) -> Option<String> {
 
 /// The field whose value starts at byte `offset` of the scene text, named as the
 /// validation messages name fields ("sphere 2: radius", "image.width"): the key of the
-/// line (when the value follows its `=`) under the table header above it.
+/// line (when the value follows its `=`) under the table header above it. `None`
+/// where that is not plain (an inline table, say): better no name than a wrong one.
 fn field_at(text: &str, offset: usize) -> Option<String> {
     let offset = text.floor_char_boundary_compat(offset.min(text.len()));
     let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
-    let (key, _) = text[line_start..offset].split_once('=')?;
+    let (key, value) = text[line_start..offset].split_once('=')?;
     let key = key.trim();
-    if key.is_empty() || key.starts_with('[') || key.contains(['#', '"', '\'']) {
+    let bare = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.');
+    if key.is_empty() || !key.chars().all(bare) || !value.trim().is_empty() {
         return None;
     }
     let before = &text[..line_start];
-    let header = before
-        .lines()
-        .rev()
-        .map(str::trim)
-        .find(|l| l.starts_with('['));
-    Some(match header {
+    // A header's table name: `[image]` → ("image", false), `[[sphere]]` → ("sphere", true).
+    let header = |line: &str| -> Option<(String, bool)> {
+        let line = line.trim();
+        let array = line.starts_with("[[");
+        let name = line.trim_start_matches('[').split(']').next()?.trim();
+        line.starts_with('[').then(|| (name.to_string(), array))
+    };
+    Some(match before.lines().rev().find_map(header) {
         None => key.to_string(),
-        Some(h) if h.starts_with("[[") => {
-            let table = h.trim_start_matches('[').split(']').next()?.trim();
+        Some((table, true)) => {
             let index = before
                 .lines()
-                .filter(|l| l.trim_start().starts_with("[[") && l.contains(table))
+                .filter_map(header)
+                .filter(|(name, array)| *array && *name == table)
                 .count();
             format!("{table} {index}: {key}")
         }
-        Some(h) => {
-            let table = h.trim_start_matches('[').split(']').next()?.trim();
-            format!("{table}.{key}")
-        }
+        Some((table, false)) => format!("{table}.{key}"),
     })
 }
 
@@ -802,6 +806,15 @@ mod tests {
                 "invalid length 2, expected an array of length 3",
                 "expected an array of 3 numbers, got 2 values",
             ),
+            (
+                // A string that holds the words of the message itself.
+                "invalid type: string \"a, expected b\", expected f64",
+                "expected a number, got the string \"a, expected b\"",
+            ),
+            (
+                "invalid type: integer `3`, expected struct FileImage",
+                "expected a table, got 3",
+            ),
         ] {
             assert_eq!(plain_type_error(serde).as_deref(), Some(plain));
         }
@@ -820,5 +833,17 @@ mod tests {
         // On a header or a key itself there is no value to name.
         assert_eq!(at("[image]"), None);
         assert_eq!(at("width"), None);
+        // An inline table is not named rather than misnamed; another array of
+        // tables whose name contains this one's is not counted.
+        let inline = "sphere = [{ center = [0, 0, -1], radius = \"big\" }]\n";
+        assert_eq!(field_at(inline, inline.find("\"big").unwrap()), None);
+        let text = "[[spotlight]]\nx = 1\n[[light]]\nintensity = z\n";
+        assert_eq!(
+            field_at(text, text.find('z').unwrap()).as_deref(),
+            Some("light 1: intensity")
+        );
+        // Offsets past the end or inside a character do not panic.
+        assert_eq!(field_at("é = ", 1), None);
+        assert_eq!(field_at("a = ", 99).as_deref(), Some("a"));
     }
 }

@@ -304,6 +304,13 @@ impl SampleTracer for FastTracer {
     }
 
     fn sample_row(&self, s: &[f32], t: f32, out: &mut [Vec3], counts: &mut RayCounts) {
+        if self.max_depth == 0 || self.cutoff != 0.0 {
+            // Nothing to share: every sample as `sample` takes it.
+            for (o, &s) in out.iter_mut().zip(s) {
+                *o = self.sample(s, t, counts);
+            }
+            return;
+        }
         let camera = RowCamera::new(self.corner, self.horizontal, self.vertical, t);
         // Runs of a few samples whose end directions fall in one cell of the eye grid
         // share that cell's spheres (`Spheres::eye_run`): an empty cell means sky, as
@@ -315,13 +322,11 @@ impl SampleTracer for FastTracer {
             camera.directions(s, &mut dirs);
             let dirs = &dirs;
             let (first, last) = (dirs[0], dirs[s.len() - 1]);
-            let run = (self.max_depth > 0)
-                .then(|| spheres.eye_run(&self.eye, first, last))
-                .flatten();
+            let run = spheres.eye_run(&self.eye, first, last);
             if run.is_some_and(|r| r.sees_nothing()) {
                 row::sky(dirs, self.compiled.sky_down, self.compiled.sky_up, out);
                 counts.primary += s.len() as u64;
-            } else if self.max_depth > 0 && self.cutoff == 0.0 {
+            } else {
                 // Two rays at a time through the eye query (see
                 // `Spheres::closest_from_eye_pair`), then shaded one by one, as `trace`.
                 let mut skipped = Skipped::default();
@@ -338,10 +343,6 @@ impl SampleTracer for FastTracer {
                         counts.primary += 1;
                         o[0] = self.shade(a, hit_a, 0, 1.0, counts, &mut skipped);
                     }
-                }
-            } else {
-                for (o, &s) in out.iter_mut().zip(s) {
-                    *o = self.sample(s, t, counts);
                 }
             }
         }

@@ -1,5 +1,6 @@
-//! Getting top-down RGBA bytes onto the window: `pixels` (wgpu) when it finds an
-//! adapter, else `softbuffer`. `WHITTED_BLIT=pixels|softbuffer` forces one.
+//! Getting top-down RGBA bytes onto the window: `pixels` (wgpu) when it finds a GPU,
+//! else `softbuffer` (also when wgpu's adapter is a CPU rasterizer such as llvmpipe).
+//! `WHITTED_BLIT=pixels|softbuffer` forces one.
 //!
 //! `pixels` keeps its texture `Rgba8UnormSrgb` and picks an sRGB surface, so the two
 //! conversions cancel and the window shows the bytes as they are, like the files.
@@ -7,6 +8,7 @@
 use std::num::NonZeroU32;
 use std::sync::Arc;
 
+use pixels::wgpu::{AdapterInfo, DeviceType};
 use pixels::{Pixels, PixelsBuilder, SurfaceTexture};
 use winit::window::Window;
 
@@ -46,19 +48,21 @@ pub enum Blitter {
 
 impl Blitter {
     /// The blitter for `window` (whose inner size is `size`, not 0×0). With `Auto`,
-    /// `pixels` on a GPU; when it fails, or when its only adapter is a CPU rasterizer
-    /// (llvmpipe, lavapipe: no GPU at all), the reason is printed and `softbuffer`
-    /// used instead. On a CPU, `pixels` draws each 1280×720 frame in ~15 ms of the
-    /// cores the render needs, `softbuffer` in ~2 ms.
+    /// `pixels` on a GPU; when it fails, or when the adapter wgpu picks is a CPU
+    /// rasterizer (llvmpipe, lavapipe: wgpu prefers any GPU to those), the reason is
+    /// printed and `softbuffer` used instead. On a CPU, `pixels` draws each 1280×720
+    /// frame in ~15 ms of the cores the render needs, `softbuffer` in ~2 ms.
     pub fn new(window: &Arc<Window>, size: (u32, u32), choice: Choice) -> Result<Blitter, String> {
         match choice {
             Choice::Pixels => Self::pixels(window, size),
             Choice::Softbuffer => Self::soft(window, size),
             Choice::Auto => {
                 let reason = match Self::pixels(window, size) {
-                    Ok(blitter) => match blitter.cpu_adapter() {
-                        None => return Ok(blitter),
-                        Some(name) => format!("the only graphics adapter, {name}, is a CPU"),
+                    Ok(blitter) => match blitter.adapter_info() {
+                        Some(info) if info.device_type == DeviceType::Cpu => {
+                            format!("the graphics adapter, {}, is a CPU", info.name)
+                        }
+                        _ => return Ok(blitter),
                     },
                     Err(e) => e,
                 };
@@ -68,21 +72,17 @@ impl Blitter {
         }
     }
 
-    /// The name of `pixels`' adapter when it is a CPU rasterizer.
-    fn cpu_adapter(&self) -> Option<String> {
-        let Blitter::Pixels { pixels, .. } = self else {
-            return None;
-        };
-        let info = pixels.adapter().get_info();
-        (info.device_type == pixels::wgpu::DeviceType::Cpu).then_some(info.name)
+    /// `pixels`' adapter (`None` for `softbuffer`).
+    fn adapter_info(&self) -> Option<AdapterInfo> {
+        match self {
+            Blitter::Pixels { pixels, .. } => Some(pixels.adapter().get_info()),
+            Blitter::Soft { .. } => None,
+        }
     }
 
     /// `pixels`' adapter: its name and kind (`None` for `softbuffer`).
     pub fn adapter(&self) -> Option<String> {
-        let Blitter::Pixels { pixels, .. } = self else {
-            return None;
-        };
-        let info = pixels.adapter().get_info();
+        let info = self.adapter_info()?;
         Some(format!("{} ({:?})", info.name, info.device_type))
     }
 

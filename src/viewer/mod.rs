@@ -274,11 +274,10 @@ impl App {
         if shown.generation != self.generation {
             return; // a stale pass of a cancelled view
         }
-        // The speed of one-sample passes (previews and first full passes) sizes the
-        // next preview, or skips it.
-        let one_sample = shown.samples <= 1;
-        if one_sample && shown.pass_seconds > 0.0 {
-            self.speed = shown.pass_pixels as f64 / shown.pass_seconds;
+        if let Some(speed) =
+            schedule::measured_speed(shown.samples, shown.pass_pixels, shown.pass_seconds)
+        {
+            self.speed = speed;
         }
         self.progress = if shown.preview {
             Progress::Preview {

@@ -48,6 +48,14 @@ pub fn preview_factor(width: u32, height: u32, pixels_per_second: f64) -> u32 {
     (factor as u32).clamp(MIN_PREVIEW_FACTOR, MAX_PREVIEW_FACTOR)
 }
 
+/// The pixels per second that size the next preview, from a pass of `pass_pixels`
+/// pixel-samples at `samples` samples so far that took `seconds`: one-sample passes
+/// only (previews and first full passes; later ones take their samples at jittered
+/// positions, a different speed). `None` leaves the last measurement.
+pub fn measured_speed(samples: u32, pass_pixels: u64, seconds: f64) -> Option<f64> {
+    (samples <= 1 && seconds > 0.0).then(|| pass_pixels as f64 / seconds)
+}
+
 /// The passes for a `width`×`height` view with `spp` samples per pixel, starting
 /// with a preview at 1/`factor` of the size (none for a factor of 1).
 pub fn plan(width: u32, height: u32, spp: u32, factor: u32) -> Vec<Pass> {

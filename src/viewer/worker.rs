@@ -278,10 +278,9 @@ fn passes<T: SampleTracer + ?Sized>(
             return Err(RenderError::Cancelled);
         }
         let start = Instant::now();
-        let mut frame = buffers.frames.take().unwrap_or_else(|| Frame::new(0, 0));
-        (frame.width, frame.height) = (w, h);
-        let mut rgba = buffers.rgba.take().unwrap_or_default();
-        let (samples, preview, pass_pixels) = match pass {
+        // The pass is traced first: a cancelled one returns here, before the screen
+        // buffers are taken (taken and dropped, they would not come back).
+        let (samples, pass_pixels, preview) = match pass {
             Pass::Preview {
                 width,
                 height,
@@ -297,33 +296,43 @@ fn passes<T: SampleTracer + ?Sized>(
                 sums.resize(width as usize * height as usize, Vec3::ZERO);
                 render::accumulate(tracer, &small, 0..1, sums, control)?;
                 let preview = render::resolve(sums, 1, width, height);
-                fill_for_screen(&mut frame, &mut rgba, |j, row| {
-                    upscaled_row(&preview, factor, j, row)
-                });
-                (0, true, u64::from(width) * u64::from(height))
+                (
+                    0,
+                    u64::from(width) * u64::from(height),
+                    Some((preview, factor)),
+                )
             }
             Pass::Samples(range) => {
-                let end = range.end;
                 let pixels = u64::from(w) * u64::from(h) * range.len() as u64;
-                let sums = &mut buffers.sums;
-                render::accumulate(tracer, opts, range, sums, control)?;
+                let end = range.end;
+                render::accumulate(tracer, opts, range, &mut buffers.sums, control)?;
+                (end, pixels, None)
+            }
+        };
+        let mut frame = buffers.frames.take().unwrap_or_else(|| Frame::new(0, 0));
+        (frame.width, frame.height) = (w, h);
+        let mut rgba = buffers.rgba.take().unwrap_or_default();
+        match &preview {
+            Some((small, factor)) => fill_for_screen(&mut frame, &mut rgba, |j, row| {
+                upscaled_row(small, *factor, j, row)
+            }),
+            None => {
                 let sums = &buffers.sums;
                 fill_for_screen(&mut frame, &mut rgba, |j, row| {
                     let from = &sums[j * row.len()..(j + 1) * row.len()];
                     for (p, &sum) in row.iter_mut().zip(from) {
-                        *p = render::pixel_value(sum, end);
+                        *p = render::pixel_value(sum, samples);
                     }
                 });
-                (end, false, pixels)
             }
-        };
+        }
         sink(Report::Frame(Shown {
             generation: job.generation,
             frame: buffers.frames.send(frame),
             rgba: buffers.rgba.send(rgba),
             samples,
             target,
-            preview,
+            preview: preview.is_some(),
             pass_pixels,
             done: index == last,
             pass_seconds: start.elapsed().as_secs_f64(),
@@ -394,9 +403,10 @@ mod tests {
     #[test]
     fn reused_buffers_give_the_same_passes_and_spare_what_is_held() {
         // Every pass of each job, with fresh buffers: what the reused ones must give.
+        // 192×108 has a preview; 96×54 has none and reuses larger buffers.
         let mut scene = hw3_scene(HW3_DEFAULT_SEED);
         scene.image.spp = 3;
-        let jobs = [(160, 90), (96, 54), (160, 90)];
+        let jobs = [(192, 108), (192, 108), (96, 54), (192, 108)];
         let fresh: Vec<Vec<Shown>> = jobs
             .iter()
             .map(|&(w, h)| collect(scene.clone(), w, h))
@@ -406,11 +416,16 @@ mod tests {
         let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
         let scene = Arc::new(scene);
         let held = Mutex::new(Vec::new());
+        let mut addresses: Vec<Vec<*const Vec3>> = Vec::new();
         for (n, &size) in jobs.iter().enumerate() {
             let seen = Mutex::new(Vec::new());
             let sink = |r: Report| match r {
                 Report::Frame(s) => {
-                    let copy = ((*s.frame).clone(), (*s.rgba).clone());
+                    let copy = (
+                        (*s.frame).clone(),
+                        (*s.rgba).clone(),
+                        s.frame.pixels.as_ptr(),
+                    );
                     seen.lock().unwrap().push(copy);
                     if n == 0 {
                         held.lock().unwrap().push(s);
@@ -422,16 +437,64 @@ mod tests {
             run(&job, &mut cache, &mut buffers, &sink).unwrap();
             let seen = seen.into_inner().unwrap();
             assert_eq!(seen.len(), fresh[n].len(), "job {n}");
-            for (k, (frame, rgba)) in seen.iter().enumerate() {
+            for (k, (frame, rgba, _)) in seen.iter().enumerate() {
                 assert_eq!(*frame, *fresh[n][k].frame, "job {n} pass {k}");
                 assert_eq!(*rgba, *fresh[n][k].rgba, "job {n} pass {k}");
             }
+            addresses.push(seen.iter().map(|s| s.2).collect());
         }
         // The passes the "window" kept were not written over by later jobs.
         for (k, s) in held.into_inner().unwrap().iter().enumerate() {
             assert_eq!(*s.frame, *fresh[0][k].frame, "held pass {k}");
             assert_eq!(*s.rgba, *fresh[0][k].rgba, "held pass {k}");
+            assert!(!addresses[1..]
+                .iter()
+                .flatten()
+                .any(|&a| a == s.frame.pixels.as_ptr()));
         }
+        // The smaller view drew into the frames of the view before it.
+        assert!(
+            addresses[2].iter().all(|a| addresses[1].contains(a)),
+            "{addresses:?}"
+        );
+    }
+
+    /// A tracer that cancels its job as soon as it traces.
+    struct Cancelling<'a> {
+        tracer: &'a FastTracer,
+        control: &'a RenderControl,
+    }
+
+    impl SampleTracer for Cancelling<'_> {
+        fn sample(&self, s: f32, t: f32, counts: &mut crate::trace::RayCounts) -> Vec3 {
+            self.control.cancel();
+            self.tracer.sample(s, t, counts)
+        }
+    }
+
+    #[test]
+    fn a_pass_cancelled_midway_keeps_the_buffers() {
+        let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+        scene.image.spp = 2;
+        let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
+        let scene = Arc::new(scene);
+        let first = Job::new(1, Arc::clone(&scene), (192, 108), 4);
+        run(&first, &mut cache, &mut buffers, &|_| {}).unwrap();
+        let pooled = (buffers.frames.sent.len(), buffers.rgba.sent.len());
+        assert!(pooled.0 > 0 && pooled.1 > 0);
+        // The next view is cancelled inside its first pass (its preview).
+        let second = Job::new(2, Arc::clone(&scene), (192, 108), 4);
+        let mut opts = RenderOptions::for_scene(&scene);
+        (opts.image.width, opts.image.height) = (192, 108);
+        let tracer = Cancelling {
+            tracer: cache.tracer(&scene, &opts).unwrap(),
+            control: &second.control,
+        };
+        let shown = |_: Report| panic!("a cancelled pass was shown");
+        let result = passes(&second, &tracer, &opts, &mut buffers, &shown);
+        assert_eq!(result, Err(RenderError::Cancelled));
+        assert_eq!((buffers.frames.sent.len(), buffers.rgba.sent.len()), pooled);
+        assert!(buffers.frames.take().is_some() && buffers.rgba.take().is_some());
     }
 
     #[test]
