@@ -318,3 +318,75 @@ fn rows_in_one_cell_get_the_per_ray_hits() {
         "too few to say anything: {runs} runs, {hits} hits"
     );
 }
+
+/// Rays going into a sphere (refracted into glass): the query takes only that sphere
+/// and the spheres overlapping it, and must find what brute force in `f64` finds among
+/// all spheres — the far side, or an overlapping sphere crossed before it.
+#[test]
+fn rays_inside_a_sphere_meet_what_brute_force_meets() {
+    let counts = RefCell::new((0u64, 0u64, 0u64)); // (rays, ambiguous, met another sphere)
+                                                   // Spheres in overlapping pairs and triples, at every scale.
+    let cluster = (
+        log_uniform(-3.0, 3.0),
+        log_uniform(-1.0, 4.0),
+        unit_vector(),
+        prop::collection::vec((unit_vector(), 0.2f64..1.6, 0.2f64..1.2), 0..3),
+    );
+    let world = prop::collection::vec(cluster, 1..40).prop_map(|clusters| {
+        let mut spheres = Vec::new();
+        for (r, d, u, others) in clusters {
+            let c = u * d;
+            spheres.push(Sphere::new(c, r));
+            for (v, off, size) in others {
+                spheres.push(Sphere::new(c + v * (r * off), r * size));
+            }
+        }
+        spheres
+    });
+    let rays = prop::collection::vec((0.0f64..1.0, unit_vector(), unit_vector()), 48);
+    runner(150)
+        .run(&(world, rays), |(spheres, rays)| {
+            let set = Spheres::new(&spheres);
+            let mut c = counts.borrow_mut();
+            for &(pick, n, towards) in &rays {
+                let s = ((pick * spheres.len() as f64) as usize).min(spheres.len() - 1);
+                let sphere = &spheres[s];
+                // A point on the sphere and a direction into it.
+                let origin = sphere.center + n * sphere.radius;
+                let inward = if towards.dot(n) < 0.0 {
+                    towards
+                } else {
+                    -towards
+                };
+                let q = Query {
+                    origin,
+                    dir: inward.as_vec3().normalize(),
+                    from: Some((s as u32, Side::Inward)),
+                };
+                let (o, d) = query_ray(&q);
+                let mut all: Vec<_> = crossings(o, d, &spheres, Some((s, Side::Inward)), q.t_min())
+                    .into_iter()
+                    .collect();
+                all.sort_by(|a, b| a.1.total_cmp(&b.1));
+                c.0 += 1;
+                let tie = all.len() >= 2 && (all[1].1 - all[0].1) <= 1e-9 * all[1].1.abs();
+                let grazing = inward.dot(n).abs() < 1e-3;
+                if all.iter().any(|x| x.3 || x.1.is_nan()) || tie || grazing {
+                    c.1 += 1;
+                    continue;
+                }
+                let want = all.first().map(|x| x.0 as u32);
+                let got = set.closest(&q).map(|h| h.sphere);
+                c.2 += u64::from(want.is_some_and(|k| k != s as u32));
+                prop_assert_eq!(got, want, "sphere {} of {}", s, spheres.len());
+            }
+            Ok(())
+        })
+        .unwrap_or_else(|e| panic!("{e}\n{:?}", counts.borrow()));
+    let (rays, ambiguous, other) = counts.into_inner();
+    println!("inside rays: {rays} ({ambiguous} ambiguous, left out), {other} met an overlapping sphere first");
+    assert!(
+        rays - ambiguous > 4000 && other > 300,
+        "too few to say anything: {rays} {ambiguous} {other}"
+    );
+}

@@ -5,7 +5,7 @@
 
 use arrayvec::ArrayVec;
 use glam::Vec3;
-use wide::{f32x4, CmpLe};
+use wide::{f32x4, CmpGe, CmpLe};
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug)]
@@ -99,6 +99,36 @@ impl Bvh {
     /// the caller lays out in this order is read from consecutive addresses.
     pub fn items(&self) -> &[u32] {
         &self.items
+    }
+
+    /// Calls `visit(slot)` for every item (`items()[slot]`) whose box overlaps the box
+    /// `[min, max]`.
+    pub fn overlapping(&self, min: Vec3, max: Vec3, mut visit: impl FnMut(u32)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let lo = [min.x, min.y, min.z].map(f32x4::splat);
+        let hi = [max.x, max.y, max.z].map(f32x4::splat);
+        // Depth first: at most three waiting children a level (as in `traverse`).
+        let mut stack: ArrayVec<u32, STACK> = ArrayVec::new();
+        stack.push(0);
+        while let Some(index) = stack.pop() {
+            let n = &self.nodes[index as usize];
+            let mut hit = n.used;
+            for a in 0..3 {
+                hit &= (n.min[a].cmp_le(hi[a]) & n.max[a].cmp_ge(lo[a])).move_mask() as u32;
+            }
+            while hit != 0 {
+                let lane = hit.trailing_zeros() as usize;
+                hit &= hit - 1;
+                let (child, count) = (n.child[lane], n.count[lane]);
+                if count == 0 {
+                    stack.push(child);
+                } else {
+                    (child..child + count).for_each(&mut visit);
+                }
+            }
+        }
     }
 
     /// Calls `visit(slot, t_max)` for every item (`items()[slot]`) whose box the ray

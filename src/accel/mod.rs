@@ -6,6 +6,8 @@ mod bvh;
 mod dirgrid;
 mod point;
 
+use std::sync::OnceLock;
+
 use glam::{DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 
@@ -139,6 +141,12 @@ pub struct Spheres {
     leaf: Vec<LeafSphere>,
     /// Around each light, for shadow rays.
     lights: Vec<PointGrid>,
+    /// Per sphere, the other spheres that overlap it: all that a ray travelling
+    /// inside it can meet before its far side (see [`Spheres::closest_inside`]).
+    /// Worked out when a ray first goes inside the sphere: most spheres never see one.
+    inside: Vec<OnceLock<Box<[u32]>>>,
+    /// Per sphere, its box as the hierarchy holds it.
+    boxes: Vec<Aabb>,
 }
 
 impl Spheres {
@@ -181,6 +189,7 @@ impl Spheres {
             })
             .collect();
         let bvh = Bvh::build(&boxes);
+        let inside = (0..spheres.len()).map(|_| OnceLock::new()).collect();
         let leaf = bvh
             .items()
             .iter()
@@ -202,6 +211,8 @@ impl Spheres {
             radius,
             quick,
             lights: Vec::new(),
+            inside,
+            boxes,
         }
     }
 
@@ -348,6 +359,11 @@ impl Spheres {
 
     /// The closest hit of a ray of any origin.
     pub fn closest(&self, q: &Query) -> Option<Hit> {
+        if let Some((s, Side::Inward)) = q.from {
+            if let Some(hit) = self.closest_inside(s, q) {
+                return Some(hit);
+            }
+        }
         let ray = Ray::new(q);
         // Worked out first (most such rays test a sphere exactly, some several): its
         // square root and division overlap the traversal.
@@ -369,6 +385,42 @@ impl Spheres {
             },
         );
         self.finish(best)
+    }
+
+    /// [`Spheres::closest`] of a ray going into sphere `s` from its surface (refracted
+    /// into glass, or reflected inside it): until it leaves by the far side, it is
+    /// inside `s`, where only `s` and the spheres that overlap it can be met; so the
+    /// closest of those is the closest of all. `None` when the far side is not found
+    /// (lost to rounding at a grazing angle): the hierarchy then decides.
+    fn closest_inside(&self, s: u32, q: &Query) -> Option<Hit> {
+        let ray = Ray::new(q);
+        let d64 = unit64(q.dir);
+        let mut best = Best::NONE;
+        self.consider_exactly(s, &ray, d64, &mut best)?;
+        let overlaps = self.inside[s as usize].get_or_init(|| self.overlapping(s));
+        for &k in overlaps.iter() {
+            self.consider(k, &ray, &mut best);
+        }
+        self.finish(best)
+    }
+
+    /// The spheres that overlap sphere `s` (or touch it, up to rounding).
+    fn overlapping(&self, s: u32) -> Box<[u32]> {
+        let s = s as usize;
+        let (c, r) = (self.center[s], self.radius[s]);
+        let bounds = &self.boxes[s];
+        let mut list = Vec::new();
+        self.bvh.overlapping(bounds.min, bounds.max, |slot| {
+            let k = self.leaf[slot as usize].k as usize;
+            let (ck, rk) = (self.center[k], self.radius[k]);
+            let reach =
+                (r + rk) * (1.0 + 1e-6) + 1e-9 * (c.abs().max_element() + ck.abs().max_element());
+            if k != s && (ck - c).length() <= reach {
+                list.push(k as u32);
+            }
+        });
+        list.sort_unstable();
+        list.into_boxed_slice()
     }
 
     /// Lowers `factor` by sphere `k`'s occlusion of the shadow segment.
