@@ -481,16 +481,31 @@ fn samples_accumulate_to_the_render_at_the_target_spp() {
     assert!(status.success());
 }
 
-#[test]
-fn without_a_gpu_adapter_it_falls_back_to_softbuffer() {
-    if !x_tools_or_skip("softbuffer fallback test") {
-        return;
+/// Opens the 320×180 one-sample scene in the viewer with `env`, waits for the
+/// finished image, checks that the window shows `whitted render`'s pixels, and quits;
+/// the viewer's stderr. `None` (said loudly) without the X tools.
+fn shows_the_render_with(test: &str, env: &[(&str, &str)]) -> Option<String> {
+    if !x_tools_or_skip(test) {
+        return None;
     }
     let x = XServer::start();
     let dir = tempfile::tempdir().unwrap();
     let dir = dir.path();
     let scene = small_scene(dir, 1);
     let expected = headless(dir, &scene, &[], "render.png");
+    let (mut viewer, window) = start_viewer_with(&x, dir, &scene, env);
+    x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
+    let stderr = viewer.stderr();
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(diff, 0, "{diff} pixels differ from `whitted render`");
+    x.key(&window, "q");
+    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
+    assert!(status.success());
+    Some(stderr)
+}
+
+#[test]
+fn without_a_gpu_adapter_it_falls_back_to_softbuffer() {
     // Vulkan only, and no Vulkan driver: wgpu finds no adapter.
     let no_gpu = [
         ("WHITTED_BLIT", ""),
@@ -498,36 +513,24 @@ fn without_a_gpu_adapter_it_falls_back_to_softbuffer() {
         ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
         ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
     ];
-    let (mut viewer, window) = start_viewer_with(&x, dir, &scene, &no_gpu);
-    x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
-    let stderr = viewer.stderr();
+    let Some(stderr) = shows_the_render_with("softbuffer fallback test", &no_gpu) else {
+        return;
+    };
     assert!(
         stderr.contains("drawing with softbuffer instead")
             && stderr.contains("stats: blitter softbuffer\n"),
         "{stderr}"
     );
-    let diff = screenshot_matching(&x, &window, dir, &expected);
-    assert_eq!(diff, 0, "{diff} pixels differ from `whitted render`");
-    x.key(&window, "q");
-    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
-    assert!(status.success());
 }
 
 /// Left to choose, the viewer draws with `pixels` on a GPU only: where wgpu's only
 /// adapter is a CPU rasterizer (lavapipe, as on CI), with `softbuffer`, and says why.
 #[test]
 fn the_automatic_blitter_uses_pixels_on_a_gpu_only() {
-    if !x_tools_or_skip("automatic blitter test") {
+    let automatic = [("WHITTED_BLIT", "")];
+    let Some(stderr) = shows_the_render_with("automatic blitter test", &automatic) else {
         return;
-    }
-    let x = XServer::start();
-    let dir = tempfile::tempdir().unwrap();
-    let dir = dir.path();
-    let scene = small_scene(dir, 1);
-    let expected = headless(dir, &scene, &[], "render.png");
-    let (mut viewer, window) = start_viewer_with(&x, dir, &scene, &[("WHITTED_BLIT", "")]);
-    x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
-    let stderr = viewer.stderr();
+    };
     if stderr.contains("stats: blitter pixels\n") {
         let adapter = stderr
             .lines()
@@ -548,16 +551,9 @@ fn the_automatic_blitter_uses_pixels_on_a_gpu_only() {
                 "{stderr}"
             );
         }
-        println!(
-            "automatic blitter: {}",
-            stderr.lines().find(|l| l.contains("instead")).unwrap()
-        );
+        let reason = stderr.lines().find(|l| l.contains("instead")).unwrap();
+        println!("automatic blitter: {reason}");
     }
-    let diff = screenshot_matching(&x, &window, dir, &expected);
-    assert_eq!(diff, 0, "{diff} pixels differ from `whitted render`");
-    x.key(&window, "q");
-    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
-    assert!(status.success());
 }
 
 #[test]
