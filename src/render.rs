@@ -124,7 +124,7 @@ pub enum RenderError {
 #[derive(Debug, Default)]
 pub struct RenderControl {
     cancel: AtomicBool,
-    pixels_done: AtomicU64,
+    pub(crate) pixels_done: AtomicU64,
 }
 
 impl RenderControl {
@@ -250,7 +250,7 @@ where
 
 /// Runs `row(j, states, counts)` for every row of `area` (`j` from the bottom of the
 /// image) with the states of its pixels; see [`for_each_pixel`].
-fn for_each_row<T, F>(
+pub(crate) fn for_each_row<T, F>(
     opts: &RenderOptions,
     area: Region,
     states: &mut [T],
@@ -302,7 +302,7 @@ where
 }
 
 /// Runs `work` on the threads `opts` asks for.
-fn in_pool<R: Send>(
+pub(crate) fn in_pool<R: Send>(
     opts: &RenderOptions,
     work: impl FnOnce() -> R + Send,
 ) -> Result<R, RenderError> {
@@ -332,9 +332,39 @@ fn thread_pool(n: usize) -> Result<Arc<rayon::ThreadPool>, RenderError> {
 /// The film abscissae of the centres of the area's columns: `film`'s `s` for one
 /// sample a pixel (the same values), worked out once.
 fn pixel_centres(opts: &RenderOptions, area: Region) -> Vec<f32> {
-    (area.x..area.x + area.width)
-        .map(|i| (i as f32 + 0.5) / opts.image.width as f32)
+    let columns: Vec<u32> = (area.x..area.x + area.width).collect();
+    centres_of(opts, &columns)
+}
+
+/// [`pixel_centres`] of some columns.
+pub(crate) fn centres_of(opts: &RenderOptions, columns: &[u32]) -> Vec<f32> {
+    columns
+        .iter()
+        .map(|&i| (i as f32 + 0.5) / opts.image.width as f32)
         .collect()
+}
+
+/// Sample 0 of the pixels `columns` (film abscissae `centres`, from [`centres_of`]) of
+/// row `j` into `out`, as [`accumulate`] of sample 0 sums it: the pixel centres a row
+/// at a time for one sample a pixel, else the first jittered sample of each.
+pub(crate) fn first_samples<T: SampleTracer + ?Sized>(
+    tracer: &T,
+    opts: &RenderOptions,
+    columns: &[u32],
+    centres: &[f32],
+    j: u32,
+    out: &mut [Vec3],
+    counts: &mut RayCounts,
+) {
+    if opts.image.spp == 1 {
+        tracer.sample_row(centres, centre_height(opts, j), out, counts);
+        return;
+    }
+    for (&i, sum) in columns.iter().zip(out) {
+        let (s, t) = film(opts, i, j, 0);
+        *sum = Vec3::ZERO;
+        *sum += tracer.sample(s, t, counts);
+    }
 }
 
 /// `film`'s `t` for one sample a pixel in row `j`.

@@ -94,8 +94,12 @@ pub fn time_render(
 #[derive(Clone, Debug)]
 pub struct OrbitTiming {
     /// Seconds of each view's first full-resolution pass (what the window then shows),
-    /// conversion to screen bytes included.
+    /// conversion to screen bytes included; after a preview it traces the pixels the
+    /// preview did not.
     pub frame_seconds: Vec<f64>,
+    /// Seconds from each view's submission to its full-resolution frame: its eye grid,
+    /// its preview (whose pixels the full pass takes) and its full pass.
+    pub view_seconds: Vec<f64>,
     /// Views that showed a preview before their full pass.
     pub previews: usize,
     /// Wall time of all the views, from the first submission to the last frame.
@@ -108,6 +112,11 @@ impl OrbitTiming {
         median(&mut self.frame_seconds.clone())
     }
 
+    /// Median seconds from a view's submission to its full-resolution frame.
+    pub fn median_view_seconds(&self) -> f64 {
+        median(&mut self.view_seconds.clone())
+    }
+
     /// Full-resolution frames per second of wall time (everything the worker does
     /// between frames included: a new view's eye grid, previews).
     pub fn frames_per_second(&self) -> f64 {
@@ -118,7 +127,7 @@ impl OrbitTiming {
     pub fn result_line(&self, scene: &str, threads: usize, (w, h): (u32, u32)) -> String {
         format!(
             "RESULT peer=whitted-viewer scene={scene} threads={threads} size={w}x{h} views={} \
-             frame_ms={:.2} best_ms={:.2} fps={:.1} previews={}",
+             frame_ms={:.2} best_ms={:.2} view_ms={:.2} fps={:.1} previews={}",
             self.frame_seconds.len(),
             self.median_frame_seconds() * 1e3,
             self.frame_seconds
@@ -126,6 +135,7 @@ impl OrbitTiming {
                 .copied()
                 .fold(f64::INFINITY, f64::min)
                 * 1e3,
+            self.median_view_seconds() * 1e3,
             self.frames_per_second(),
             self.previews,
         )
@@ -155,6 +165,7 @@ pub fn time_orbit(
     let mut speed = f64::NAN;
     let mut timing = OrbitTiming {
         frame_seconds: Vec::new(),
+        view_seconds: Vec::new(),
         previews: 0,
         wall_seconds: 0.0,
     };
@@ -195,6 +206,7 @@ pub fn time_orbit(
         timing.previews += usize::from(shown.iter().any(|s| s.preview));
         if let Some(full) = shown.iter().find(|s| !s.preview) {
             timing.frame_seconds.push(full.pass_seconds);
+            timing.view_seconds.push(full.since_submit);
         }
     }
     timing.wall_seconds = start.elapsed().as_secs_f64();

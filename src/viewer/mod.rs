@@ -12,6 +12,7 @@ pub mod blit;
 pub mod buffer;
 pub mod controls;
 pub mod inspect;
+pub mod lattice;
 pub mod save;
 pub mod schedule;
 pub mod status;

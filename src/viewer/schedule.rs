@@ -1,8 +1,9 @@
 //! Progressive refinement: the passes one view is rendered in. First a coarse preview
 //! at a fraction of the resolution (fast, so that dragging the mouse stays fluid), then
-//! the full resolution at one sample per pixel, then more samples in growing batches
-//! up to the target. Sample batches cover `0..spp` in order without gaps, so the sums
-//! (and so the pixels) equal a single render of all samples.
+//! the full resolution at one sample per pixel (the preview's pixels taken as they
+//! are), then more samples in growing batches up to the target. Sample batches cover
+//! `0..spp` in order without gaps, so the sums (and so the pixels) equal a single
+//! render of all samples.
 
 use std::ops::Range;
 
@@ -20,8 +21,9 @@ const MAX_BATCH: u32 = 8;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Pass {
-    /// The whole image at `width`×`height` (1/`factor` of the size), one sample per
-    /// pixel, shown scaled up.
+    /// The whole image at `width`×`height` (1/`factor` of the size): the first sample
+    /// of one pixel of every `factor`×`factor` block (see `viewer::lattice`), shown
+    /// scaled up, and taken by the first full pass.
     Preview {
         width: u32,
         height: u32,

@@ -19,6 +19,7 @@ use crate::trace::fast::FastTracer;
 use crate::trace::SampleTracer;
 
 use super::buffer::{fill_for_screen, upscaled_row};
+use super::lattice::{self, Lattice};
 use super::schedule::{plan, Pass};
 
 /// One view to render: the scene (its camera is the view's), at this size.
@@ -273,6 +274,8 @@ fn passes<T: SampleTracer + ?Sized>(
     let passes = plan(w, h, target, job.preview_factor);
     let last = passes.len() - 1;
     buffers.sums.resize(w as usize * h as usize, Vec3::ZERO);
+    // The lattice a preview has traced, until the first full pass takes it.
+    let mut previewed = None;
     for (index, pass) in passes.into_iter().enumerate() {
         if control.is_cancelled() {
             return Err(RenderError::Cancelled);
@@ -286,16 +289,14 @@ fn passes<T: SampleTracer + ?Sized>(
                 height,
                 factor,
             } => {
-                // The full-size tracer: its camera takes film positions in [0,1]², so
-                // fewer pixels give the same view, and nothing is compiled twice.
-                let mut small = opts.clone();
-                small.image.width = width;
-                small.image.height = height;
-                small.image.spp = 1;
-                let sums = &mut buffers.preview_sums;
-                sums.resize(width as usize * height as usize, Vec3::ZERO);
-                render::accumulate(tracer, &small, 0..1, sums, control)?;
-                let preview = render::resolve(sums, 1, width, height);
+                // One pixel of each block, as the first full pass would trace it: that
+                // pass then takes these instead of tracing them again.
+                let lattice = Lattice { factor };
+                let values = &mut buffers.preview_sums;
+                values.resize(width as usize * height as usize, Vec3::ZERO);
+                lattice::sample_lattice(tracer, opts, lattice, values, control)?;
+                previewed = Some(lattice);
+                let preview = render::resolve(values, 1, width, height);
                 (
                     0,
                     u64::from(width) * u64::from(height),
@@ -303,9 +304,25 @@ fn passes<T: SampleTracer + ?Sized>(
                 )
             }
             Pass::Samples(range) => {
-                let pixels = u64::from(w) * u64::from(h) * range.len() as u64;
                 let end = range.end;
-                render::accumulate(tracer, opts, range, &mut buffers.sums, control)?;
+                let mut pixels = u64::from(w) * u64::from(h) * range.len() as u64;
+                match previewed.take() {
+                    Some(lattice) if range == (0..1) => {
+                        let values = &buffers.preview_sums;
+                        pixels -= values.len() as u64;
+                        lattice::accumulate_first_around(
+                            tracer,
+                            opts,
+                            lattice,
+                            values,
+                            &mut buffers.sums,
+                            control,
+                        )?;
+                    }
+                    _ => {
+                        render::accumulate(tracer, opts, range, &mut buffers.sums, control)?;
+                    }
+                }
                 (end, pixels, None)
             }
         };
@@ -387,17 +404,73 @@ mod tests {
         opts.image.height = h;
         let (expected, _) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
         assert_eq!(*shown.last().unwrap().frame, expected);
-        // The preview is the same view at a quarter of the size, scaled up.
-        let mut small = opts.clone();
-        (small.image.width, small.image.height, small.image.spp) = (w / 4, h / 4, 1);
-        let (preview, _) = render::render(&scene, &small, &RenderControl::default()).unwrap();
-        assert_eq!(*shown[0].frame, upscale(&preview, 4, w, h));
-        // The 1-sample pass is the first sample of the 5-spp pattern.
+        // The 1-sample pass is the first sample of the 5-spp pattern (its lattice
+        // taken from the preview).
         let tracer = render::make_tracer(&scene, &opts).unwrap();
         let mut sums = vec![Vec3::ZERO; (w * h) as usize];
         render::accumulate(tracer.as_ref(), &opts, 0..1, &mut sums, &Default::default()).unwrap();
-        assert_eq!(*shown[1].frame, render::resolve(&sums, 1, w, h));
+        let first = render::resolve(&sums, 1, w, h);
+        assert_eq!(*shown[1].frame, first);
         assert_eq!(*shown[1].rgba, to_rgba_top_down(&shown[1].frame));
+        assert_eq!(*shown[0].frame, expected_preview(&first, 4));
+    }
+
+    /// What a preview at 1/`factor` of the size shows, from the first full pass: the
+    /// pixel in the middle of each block (the block's last one at a short edge),
+    /// repeated over the block.
+    fn expected_preview(first: &Frame, factor: u32) -> Frame {
+        let (w, h) = (first.width, first.height);
+        let (pw, ph) = (w.div_ceil(factor), h.div_ceil(factor));
+        let mut small = Frame::new(pw, ph);
+        for b in 0..ph {
+            for a in 0..pw {
+                let i = (a * factor + factor / 2).min(w - 1);
+                let j = (b * factor + factor / 2).min(h - 1);
+                small.pixels[(b * pw + a) as usize] = first.get(i, j);
+            }
+        }
+        upscale(&small, factor, w, h)
+    }
+
+    #[test]
+    fn one_sample_views_take_the_preview_pixels_into_the_full_frame() {
+        // One sample a pixel (the orbit's case: a row at a time through the tracer),
+        // sizes that do not divide by the factor, the fast and the reference tracer.
+        for renderer in [Renderer::Fast, Renderer::Reference] {
+            let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+            scene.image.spp = 1;
+            let (w, h) = (190, 107);
+            let job = |s: &Scene| Job::new(1, Arc::new(s.clone()), (w, h), 3);
+            let mut opts = RenderOptions::for_scene(&scene);
+            (opts.image.width, opts.image.height) = (w, h);
+            opts.renderer = renderer;
+            let shown = Mutex::new(Vec::new());
+            let sink = |r: Report| match r {
+                Report::Frame(s) => shown.lock().unwrap().push(s),
+                Report::Failed { message, .. } => panic!("render failed: {message}"),
+            };
+            let tracer = render::make_tracer(&scene, &opts).unwrap();
+            passes(
+                &job(&scene),
+                tracer.as_ref(),
+                &opts,
+                &mut Buffers::default(),
+                &sink,
+            )
+            .unwrap();
+            let shown = shown.into_inner().unwrap();
+            assert_eq!(shown.len(), 2, "{renderer:?}");
+            let (expected, _) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+            assert_eq!(*shown[1].frame, expected, "{renderer:?}");
+            assert_eq!(
+                *shown[0].frame,
+                expected_preview(&expected, 3),
+                "{renderer:?}"
+            );
+            // The full pass traced the pixels the preview had not.
+            assert_eq!(shown[0].pass_pixels, 64 * 36);
+            assert_eq!(shown[1].pass_pixels, u64::from(w * h) - 64 * 36);
+        }
     }
 
     #[test]
