@@ -49,17 +49,25 @@ impl Format {
 }
 
 /// A linear value to 8 bits: `round(clamp(c, 0, 1)·255)`, no gamma (SPEC §2).
-#[inline]
+#[inline(always)]
 pub fn to_byte(c: f32) -> u8 {
-    // NaN fails both comparisons of clamp's inputs; map it to 0 explicitly.
-    if c.is_nan() {
-        return 0;
-    }
-    // round() half away from zero, exactly: x + 0.5 is exact in f64 for an f32 x, and
-    // the conversion truncates. (`f32::round` is a libm call on baseline x86-64, which
-    // made converting a 1280×720 frame for the window take 4–5 ms.)
-    (f64::from(c.clamp(0.0, 1.0) * 255.0) + 0.5) as u8
+    // Without a branch or a libm call, as the window converts every pixel of every
+    // frame with it (`f32::round` is a libm call on baseline x86-64). `max` drops a
+    // NaN, so NaN gives 0.
+    #[allow(clippy::manual_clamp)] // not `clamp`, which would keep a NaN
+    let x = c.max(0.0).min(1.0) * 255.0;
+    // x + 2²³ lies in [2²³, 2²³ + 255], where the f32 spacing is 1: the addition
+    // rounds x to the nearest integer r, ties to even, and r sits in the low bits.
+    let y = x + ROUNDER;
+    let r = y - ROUNDER;
+    // Round half away from zero instead: a tie rounded down to even is x = r + ½
+    // (x − r is exact: Sterbenz, or x itself when r = 0).
+    let tie_down = u32::from(x - r == 0.5);
+    (y.to_bits() - ROUNDER.to_bits() + tie_down) as u8
 }
+
+/// 2²³: the smallest f32 whose spacing is 1.
+const ROUNDER: f32 = 8_388_608.0;
 
 /// The frame as 8-bit RGB, row 0 at the TOP (the order of files and screens).
 pub fn to_rgb8(frame: &Frame) -> RgbImage {

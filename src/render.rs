@@ -427,6 +427,25 @@ pub fn resolve(sums: &[Vec3], samples: u32, width: u32, height: u32) -> Frame {
     }
 }
 
+/// [`pixel_value`] of each of `sums` into `out`: for one sample a copy, mended where
+/// not finite (looked for without a branch a pixel, as `render` does).
+pub fn pixel_values(sums: &[Vec3], samples: u32, out: &mut [Vec3]) {
+    if samples > 1 {
+        for (p, &sum) in out.iter_mut().zip(sums) {
+            *p = pixel_value(sum, samples);
+        }
+        return;
+    }
+    out.copy_from_slice(sums);
+    #[allow(clippy::eq_op)] // p − p is 0 for a finite p and NaN otherwise
+    let poison = out.iter().fold(Vec3::ZERO, |sum, &p| sum + (p - p));
+    if poison != Vec3::ZERO {
+        for p in out.iter_mut().filter(|p| !p.is_finite()) {
+            *p = Vec3::ZERO;
+        }
+    }
+}
+
 /// A sum of `samples` samples as a finite pixel value.
 #[inline]
 pub fn pixel_value(sum: Vec3, samples: u32) -> Vec3 {

@@ -270,14 +270,22 @@ fn bytes_are_rounded_and_clamped_linear_values() {
 
 #[test]
 fn bytes_round_every_value_as_round_does() {
-    // Every f32 in [0, 1] whose bits are a multiple of 7 (about 150 million values),
-    // and the halfway points k + 0.5 and their neighbours: the same byte as
-    // `(c·255).round()` (half away from zero).
+    // Every f32 in [0, 1] (about a billion values: to_byte rounds with the 2²³ trick,
+    // so every one is checked), every 4099th f32 of the whole range (negatives, above
+    // 1, infinities, NaNs with any payload), and the halfway points k + 0.5 and their
+    // neighbours: the same byte as `(c·255).round()` (half away from zero), 0 for NaN.
     let check = |c: f32| {
-        let want = (c.clamp(0.0, 1.0) * 255.0).round() as u8;
+        let want = if c.is_nan() {
+            0
+        } else {
+            (c.clamp(0.0, 1.0) * 255.0).round() as u8
+        };
         assert_eq!(image_io::to_byte(c), want, "c = {c:e} ({:#x})", c.to_bits());
     };
-    for bits in (0..=1.0f32.to_bits()).step_by(7) {
+    for bits in 0..=1.0f32.to_bits() {
+        check(f32::from_bits(bits));
+    }
+    for bits in (0..=u32::MAX).step_by(4099) {
         check(f32::from_bits(bits));
     }
     for k in 0..255 {

@@ -104,6 +104,15 @@ pub fn accumulate_first_around<T: SampleTracer + ?Sized>(
         .iter()
         .partition(|&&i| !lattice.holds(i - area.x, area.width));
     let rest_centres = render::centres_of(opts, &rest);
+    // Where each goes in the row, and from which block (no division a pixel).
+    let rest_at: Vec<usize> = rest.iter().map(|&i| (i - area.x) as usize).collect();
+    let picked_at: Vec<(usize, usize)> = picked
+        .iter()
+        .map(|&i| {
+            let a = i - area.x;
+            (a as usize, (a / lattice.factor) as usize)
+        })
+        .collect();
     let j0 = opts.image.height - (area.y + area.height);
     render::for_each_row(opts, area, sums, 1, 1, control, |j, row, counts| {
         let r = j - j0;
@@ -113,13 +122,12 @@ pub fn accumulate_first_around<T: SampleTracer + ?Sized>(
         }
         let mut traced = vec![Vec3::ZERO; rest.len()];
         render::first_samples(tracer, opts, &rest, &rest_centres, j, &mut traced, counts);
-        for (&i, value) in rest.iter().zip(traced) {
-            row[(i - area.x) as usize] = value;
+        for (&a, value) in rest_at.iter().zip(traced) {
+            row[a] = value;
         }
         let block_row = &values[(r / lattice.factor * bw) as usize..][..bw as usize];
-        for &i in &picked {
-            let a = i - area.x;
-            row[a as usize] = block_row[(a / lattice.factor) as usize];
+        for &(a, b) in &picked_at {
+            row[a] = block_row[b];
         }
     })
 }

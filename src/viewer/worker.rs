@@ -337,9 +337,7 @@ fn passes<T: SampleTracer + ?Sized>(
                 let sums = &buffers.sums;
                 fill_for_screen(&mut frame, &mut rgba, |j, row| {
                     let from = &sums[j * row.len()..(j + 1) * row.len()];
-                    for (p, &sum) in row.iter_mut().zip(from) {
-                        *p = render::pixel_value(sum, samples);
-                    }
+                    render::pixel_values(from, samples, row);
                 });
             }
         }
