@@ -781,6 +781,35 @@ mod tests {
     }
 
     #[test]
+    fn pixel_values_of_a_row_are_each_pixel_value() {
+        let sums = [
+            Vec3::new(0.5, 1.5, 3.0),
+            Vec3::new(f32::NAN, 0.25, 0.0),
+            Vec3::new(1.0, f32::INFINITY, 2.0),
+            Vec3::new(-0.0, 7.0, 1e-30),
+        ];
+        for samples in [0, 1, 3] {
+            let mut out = [Vec3::splat(9.0); 4];
+            pixel_values(&sums, samples, &mut out);
+            for (k, (&o, &s)) in out.iter().zip(&sums).enumerate() {
+                let want = pixel_value(s, samples);
+                assert_eq!(
+                    o.to_array().map(f32::to_bits),
+                    want.to_array().map(f32::to_bits)
+                );
+                assert!(o.is_finite(), "samples {samples}, pixel {k}");
+            }
+        }
+        // With one sample, a finite sum is its own value; a poisoned one is black.
+        let mut out = [Vec3::ZERO; 4];
+        pixel_values(&sums, 1, &mut out);
+        assert_eq!(
+            [out[0], out[1], out[2], out[3]],
+            [sums[0], Vec3::ZERO, Vec3::ZERO, sums[3]]
+        );
+    }
+
+    #[test]
     fn no_nan_or_infinity_reaches_a_frame() {
         for spp in [1, 2] {
             let mut opts = RenderOptions::for_scene(&crate::scene::hw3_scene(0));
