@@ -394,12 +394,13 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
     control: &RenderControl,
 ) -> Result<RayCounts, RenderError> {
     let area = opts.area();
-    if opts.image.spp == 1 && samples == (0..1) {
-        // One sample a pixel, at its centre: whole rows at once, written in place, as
-        // `render` does.
-        let centres = pixel_centres(opts, area);
+    if samples == (0..1) {
+        // The first sample: whole rows at once, written in place (`first_samples`, which
+        // the viewer's preview shares).
+        let columns: Vec<u32> = (area.x..area.x + area.width).collect();
+        let centres = centres_of(opts, &columns);
         return for_each_row(opts, area, sums, 1, 1, control, |j, row, counts| {
-            tracer.sample_row(&centres, centre_height(opts, j), row, counts);
+            first_samples(tracer, opts, &columns, &centres, j, row, counts);
         });
     }
     let n = samples.len() as u64;

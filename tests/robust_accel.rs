@@ -324,8 +324,9 @@ fn rows_in_one_cell_get_the_per_ray_hits() {
 /// all spheres — the far side, or an overlapping sphere crossed before it.
 #[test]
 fn rays_inside_a_sphere_meet_what_brute_force_meets() {
-    let counts = RefCell::new((0u64, 0u64, 0u64)); // (rays, ambiguous, met another sphere)
-                                                   // Spheres in overlapping pairs and triples, at every scale.
+    // (rays, ambiguous, met another sphere)
+    let counts = RefCell::new((0u64, 0u64, 0u64));
+    // Spheres in overlapping pairs and triples, at every scale.
     let cluster = (
         log_uniform(-3.0, 3.0),
         log_uniform(-1.0, 4.0),

@@ -71,13 +71,16 @@ impl FastTracer {
             materials: scene
                 .spheres
                 .iter()
-                .map(|s| Material {
-                    color: s.color.as_vec3(),
-                    w_r: s.reflect as f32,
-                    w_t: s.transmit as f32,
-                    ior: s.ior as f32,
-                    branches: Branches::of(s.reflect, s.transmit),
-                    only_local: Branches::of(s.reflect, s.transmit).only_local(),
+                .map(|s| {
+                    let branches = Branches::of(s.reflect, s.transmit);
+                    Material {
+                        color: s.color.as_vec3(),
+                        w_r: s.reflect as f32,
+                        w_t: s.transmit as f32,
+                        ior: s.ior as f32,
+                        branches,
+                        only_local: branches.only_local(),
+                    }
                 })
                 .collect(),
             lights: scene

@@ -120,10 +120,20 @@ pub fn accumulate_first_around<T: SampleTracer + ?Sized>(
             render::first_samples(tracer, opts, &all, &all_centres, j, row, counts);
             return;
         }
-        let mut traced = vec![Vec3::ZERO; rest.len()];
-        render::first_samples(tracer, opts, &rest, &rest_centres, j, &mut traced, counts);
-        for (&a, value) in rest_at.iter().zip(traced) {
-            row[a] = value;
+        // Traced into the front of the row, then moved to their places from the last
+        // one down (each place lies at or after its value's, so nothing unread is
+        // overwritten): no buffer a row.
+        render::first_samples(
+            tracer,
+            opts,
+            &rest,
+            &rest_centres,
+            j,
+            &mut row[..rest.len()],
+            counts,
+        );
+        for (k, &a) in rest_at.iter().enumerate().rev() {
+            row[a] = row[k];
         }
         let block_row = &values[(r / lattice.factor * bw) as usize..][..bw as usize];
         for &(a, b) in &picked_at {
