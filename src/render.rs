@@ -444,10 +444,16 @@ pub fn pixel_values(sums: &[Vec3], samples: u32, out: &mut [Vec3]) {
         return;
     }
     out.copy_from_slice(sums);
+    mend_non_finite(out);
+}
+
+/// The values of one-sample pixels in place: anything non-finite becomes 0 (looked
+/// for without a branch a pixel).
+pub fn mend_non_finite(values: &mut [Vec3]) {
     #[allow(clippy::eq_op)] // p − p is 0 for a finite p and NaN otherwise
-    let poison = out.iter().fold(Vec3::ZERO, |sum, &p| sum + (p - p));
+    let poison = values.iter().fold(Vec3::ZERO, |sum, &p| sum + (p - p));
     if poison != Vec3::ZERO {
-        for p in out.iter_mut().filter(|p| !p.is_finite()) {
+        for p in values.iter_mut().filter(|p| !p.is_finite()) {
             *p = Vec3::ZERO;
         }
     }

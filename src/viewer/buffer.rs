@@ -9,8 +9,6 @@ use rayon::prelude::*;
 use crate::image_io::to_byte;
 use crate::render::Frame;
 
-use super::schedule::preview_source;
-
 /// The frame as RGBA bytes, row 0 at the top, alpha 255 (the layout of `pixels`).
 /// Rows in parallel: serially this took a fifth of a full-resolution pass.
 pub fn to_rgba_top_down(frame: &Frame) -> Vec<u8> {
@@ -27,12 +25,18 @@ pub fn to_rgba_top_down(frame: &Frame) -> Vec<u8> {
 /// every caller (inlined, its cost moved by a quarter with unrelated changes).
 #[inline(never)]
 fn rgba_row(pixels: &[Vec3], out: &mut [u8]) {
-    for (o, p) in out.chunks_exact_mut(4).zip(pixels) {
-        // One 32-bit store a pixel.
-        let [r, g, b] = [p.x, p.y, p.z].map(|c| u32::from(to_byte(c)));
-        let word = r | g << 8 | b << 16 | 0xff << 24;
-        o.copy_from_slice(&word.to_le_bytes());
+    let (out, _) = out.as_chunks_mut::<4>();
+    for (o, p) in out.iter_mut().zip(pixels) {
+        *o = rgba_word(*p);
     }
+}
+
+/// A pixel as RGBA bytes, alpha 255: built as one 32-bit word, so that it is stored
+/// once (the compiler then converts four pixels at a time).
+#[inline(always)]
+fn rgba_word(p: Vec3) -> [u8; 4] {
+    let [r, g, b] = [p.x, p.y, p.z].map(|c| u32::from(to_byte(c)));
+    (r | g << 8 | b << 16 | 0xff << 24).to_le_bytes()
 }
 
 /// Fills every row of `frame` (its size set beforehand) with `row(j, pixels)`, `j`
@@ -60,34 +64,54 @@ pub fn fill_for_screen(
         });
 }
 
-/// Row `j` (from the bottom) of `frame` when it shows `preview` (rendered at
-/// 1/`factor` of the size) with each of its pixels as a `factor`×`factor` block,
-/// anchored at the bottom-left like the image.
-pub fn upscaled_row(preview: &Frame, factor: u32, j: usize, row: &mut [Vec3]) {
-    // The source column advances every `factor` pixels: a division a pixel (as in
-    // `preview_source`) cost a third of the conversion for the screen.
-    let (_, pj) = preview_source(0, j as u32, factor);
-    let (pw, pj) = (preview.width as usize, pj.min(preview.height - 1) as usize);
-    let source = &preview.pixels[pj * pw..(pj + 1) * pw];
-    let (mut pi, mut left) = (0, factor);
-    for p in row.iter_mut() {
-        *p = source[pi.min(pw - 1)];
-        left -= 1;
-        if left == 0 {
-            (pi, left) = (pi + 1, factor);
-        }
+/// [`fill_for_screen`] for a frame that shows `preview` (rendered at 1/`factor` of
+/// the size) with each of its pixels as a `factor`×`factor` block, anchored at the
+/// bottom-left like the image (a block cut by the top or right edge is cut short; a
+/// `preview` too small for the frame goes on with its last column and row).
+///
+/// A row of blocks at a time: each preview pixel is converted to bytes once, not once
+/// a pixel of its block, and the block's first row is copied into the others (the
+/// conversion and a division a pixel had been a sixth of a preview's time).
+pub fn fill_upscaled_for_screen(
+    frame: &mut Frame,
+    rgba: &mut Vec<u8>,
+    preview: &Frame,
+    factor: u32,
+) {
+    let (w, factor) = (frame.width as usize, factor.max(1) as usize);
+    let n = w * frame.height as usize;
+    frame.pixels.resize(n, Vec3::ZERO);
+    rgba.resize(n * 4, 0);
+    let (pw, ph) = (preview.width as usize, preview.height as usize);
+    if n == 0 || pw * ph == 0 {
+        return;
     }
-}
-
-/// A `width`×`height` frame showing `preview` scaled up (see [`upscaled_row`]).
-pub fn upscale(preview: &Frame, factor: u32, width: u32, height: u32) -> Frame {
-    let mut frame = Frame::new(width, height);
     frame
         .pixels
-        .par_chunks_mut(width.max(1) as usize)
+        .par_chunks_mut(w * factor)
+        // Screen rows run top-down: the bottom row of blocks is at the end.
+        .zip(rgba.par_rchunks_mut(w * 4 * factor))
         .enumerate()
-        .for_each(|(j, row)| upscaled_row(preview, factor, j, row));
-    frame
+        .for_each(|(block_row, (pixels, bytes))| {
+            let start = block_row.min(ph - 1) * pw;
+            let source = &preview.pixels[start..start + pw];
+            let mut words = vec![[0u8; 4]; pw];
+            rgba_row(source, words.as_flattened_mut());
+            let (first, rest) = pixels.split_at_mut(w);
+            let (first_bytes, rest_bytes) = bytes.split_at_mut(w * 4);
+            // The source column advances every `factor` pixels and stops at the last.
+            let (mut from, mut left) = (0, factor);
+            for (p, o) in first.iter_mut().zip(first_bytes.as_chunks_mut::<4>().0) {
+                (*p, *o) = (source[from], words[from]);
+                left -= 1;
+                if left == 0 {
+                    (from, left) = ((from + 1).min(pw - 1), factor);
+                }
+            }
+            rest.chunks_mut(w)
+                .for_each(|row| row.copy_from_slice(first));
+            (rest_bytes.chunks_mut(w * 4)).for_each(|row| row.copy_from_slice(first_bytes));
+        });
 }
 
 /// Where a `w`×`h` image sits, centred, in a `surface_w`×`surface_h` surface: the
@@ -178,13 +202,27 @@ mod tests {
     }
 
     #[test]
-    fn upscale_repeats_blocks_from_the_bottom_left() {
+    fn upscaled_previews_repeat_blocks_from_the_bottom_left() {
         let preview = frame();
-        let big = upscale(&preview, 2, 5, 3);
-        assert_eq!(big.get(0, 0), preview.get(0, 0));
-        assert_eq!(big.get(1, 1), preview.get(0, 0));
-        assert_eq!(big.get(2, 1), preview.get(1, 0));
-        assert_eq!(big.get(4, 2), preview.get(2, 1));
+        // 5×3 from 3×2 at factor 2: the top row and the right column are half blocks.
+        let mut big = Frame::new(5, 3);
+        let mut rgba = Vec::new();
+        fill_upscaled_for_screen(&mut big, &mut rgba, &preview, 2);
+        for (i, j, (pi, pj)) in [
+            (0, 0, (0, 0)),
+            (1, 1, (0, 0)),
+            (2, 1, (1, 0)),
+            (4, 2, (2, 1)),
+        ] {
+            assert_eq!(big.get(i, j), preview.get(pi, pj), "({i}, {j})");
+        }
+        assert_eq!(rgba, to_rgba_top_down(&big));
+        // A preview too small for the frame: its last column and row go on.
+        let mut wide = Frame::new(8, 6);
+        fill_upscaled_for_screen(&mut wide, &mut rgba, &preview, 2);
+        assert_eq!(wide.get(7, 5), preview.get(2, 1));
+        assert_eq!(wide.get(7, 0), preview.get(2, 0));
+        assert_eq!(rgba, to_rgba_top_down(&wide));
     }
 
     #[test]

@@ -81,12 +81,6 @@ pub fn plan(width: u32, height: u32, spp: u32, factor: u32) -> Vec<Pass> {
     passes
 }
 
-/// The preview pixel that full-resolution pixel `(i, j)` shows (either row order, as
-/// long as both images use the same one).
-pub fn preview_source(i: u32, j: u32, factor: u32) -> (u32, u32) {
-    (i / factor, j / factor)
-}
-
 /// When to start rendering a changed camera. A drag moves the camera more often than
 /// a preview renders; starting a view at every move would cancel each one before it
 /// shows anything. So a change waits while the current view has nothing on screen
@@ -232,12 +226,5 @@ mod tests {
         assert!(!t.changed());
         t.started(); // e.g. a resize started a view anyway: the wait is over
         assert!(!t.shown());
-    }
-
-    #[test]
-    fn preview_pixels_cover_blocks() {
-        assert_eq!(preview_source(0, 0, 4), (0, 0));
-        assert_eq!(preview_source(3, 7, 4), (0, 1));
-        assert_eq!(preview_source(320, 4, 4), (80, 1));
     }
 }
