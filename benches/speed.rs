@@ -1,5 +1,6 @@
 //! Speed benchmarks (`cargo bench`): the intersection kernel, the acceleration build,
-//! and whole frames of the peers' scenes. Compare runs of one sitting, as ratios.
+//! whole frames of the peers' scenes, and the viewer's views and screen conversions.
+//! Compare runs of one sitting, as ratios.
 
 use std::hint::black_box;
 
@@ -101,5 +102,77 @@ fn frames(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, kernel, build, frames);
+/// The viewer: a view of the orbit as the window renders it (a 2×2 preview, then the
+/// full pass that takes its pixels), and the conversions for the screen.
+fn viewer(c: &mut Criterion) {
+    use std::sync::Arc;
+    use whitted::viewer::buffer::{blit_xrgb, fill_for_screen, fill_upscaled_for_screen};
+    use whitted::viewer::controls::{Action, CameraControl};
+    use whitted::viewer::worker::{self, Buffers, Job, TracerCache};
+    use whitted::Frame;
+
+    let (w, h) = (1280, 720);
+    let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+    scene.image.spp = 1;
+    // Views 25 and 26 of `whitted time --orbit`, in turn: each iteration is a new
+    // camera, so its eye grid is built as in a drag.
+    let mut camera = CameraControl::new(&scene);
+    let drag = Action::Drag {
+        dx: 10.0,
+        dy: 0.0,
+        height: h,
+    };
+    let mut views = Vec::new();
+    for view in 1..=26 {
+        camera.apply(&scene, w, h, drag);
+        if view >= 25 {
+            let mut seen = scene.clone();
+            seen.camera = Some(camera.spec(&scene, w, h));
+            views.push(Arc::new(seen));
+        }
+    }
+    let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
+    let mut group = c.benchmark_group("viewer");
+    group.sample_size(20);
+    let mut turn = 0;
+    group.bench_function("orbit_view_hw3_1280x720_preview_2", |b| {
+        b.iter(|| {
+            turn += 1;
+            let job = Job::new(turn, Arc::clone(&views[turn as usize % 2]), (w, h), 2);
+            worker::run(&job, &mut cache, &mut buffers, &|r| drop(black_box(r))).expect("renders")
+        })
+    });
+
+    let image = render(
+        &scene,
+        &RenderOptions::for_scene(&scene),
+        &RenderControl::default(),
+    )
+    .expect("renders")
+    .0;
+    let (mut frame, mut rgba) = (Frame::new(w, h), Vec::new());
+    group.bench_function("screen_fill_1280x720", |b| {
+        b.iter(|| {
+            fill_for_screen(&mut frame, &mut rgba, |j, row| {
+                let from = &image.pixels[j * row.len()..(j + 1) * row.len()];
+                whitted::render::pixel_values(from, 1, row)
+            })
+        })
+    });
+    let mut small = RenderOptions::for_scene(&scene);
+    (small.image.width, small.image.height) = (w / 2, h / 2);
+    let preview = render(&scene, &small, &RenderControl::default())
+        .expect("renders")
+        .0;
+    group.bench_function("preview_fill_1280x720_factor_2", |b| {
+        b.iter(|| fill_upscaled_for_screen(&mut frame, &mut rgba, &preview, 2))
+    });
+    let mut surface = vec![0u32; (w * h) as usize];
+    group.bench_function("blit_xrgb_1280x720", |b| {
+        b.iter(|| blit_xrgb(&rgba, w, h, &mut surface, w, h))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, kernel, build, frames, viewer);
 criterion_main!(benches);
