@@ -108,9 +108,12 @@ pub fn fill_upscaled_for_screen(
                     (from, left) = ((from + 1).min(pw - 1), factor);
                 }
             }
-            rest.chunks_mut(w)
-                .for_each(|row| row.copy_from_slice(first));
-            (rest_bytes.chunks_mut(w * 4)).for_each(|row| row.copy_from_slice(first_bytes));
+            for row in rest.chunks_mut(w) {
+                row.copy_from_slice(first);
+            }
+            for row in rest_bytes.chunks_mut(w * 4) {
+                row.copy_from_slice(first_bytes);
+            }
         });
 }
 
@@ -135,7 +138,8 @@ pub fn blit_xrgb(rgba: &[u8], w: u32, h: u32, dst: &mut [u32], surface_w: u32, s
         (first as usize, end.max(first) as usize)
     };
     let ((x0, x1), (y0, y1)) = (visible(ox, w, surface_w), visible(oy, h, surface_h));
-    if ox > 0 || oy > 0 || (x1 - x0, y1 - y0) != (surface_w as usize, surface_h as usize) {
+    // Black only where a border shows: the image covers less than the surface.
+    if (x1 - x0, y1 - y0) != (surface_w as usize, surface_h as usize) {
         dst.fill(0);
     }
     let (w, sw) = (w as usize, surface_w as usize);
