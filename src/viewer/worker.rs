@@ -165,6 +165,8 @@ fn serve(rx: Receiver<Job>, sink: impl Fn(Report)) {
 #[derive(Default)]
 pub struct TracerCache {
     last: Option<(Arc<Scene>, FastTracer)>,
+    /// How many times a scene was compiled (hierarchy, lights' grids) from scratch.
+    pub compiles: u64,
 }
 
 impl TracerCache {
@@ -177,12 +179,23 @@ impl TracerCache {
             .map_err(|m| RenderError::Invalid(format!("camera: {m}")))?;
         let depth = opts.image.max_depth;
         let tracer = match self.last.take() {
-            Some((s, previous)) if Arc::ptr_eq(&s, scene) => previous.with_camera(&camera, depth),
-            _ => FastTracer::new(scene, &camera, depth),
+            Some((s, previous)) if same_contents(&s, scene) => previous.with_camera(&camera, depth),
+            _ => {
+                self.compiles += 1;
+                FastTracer::new(scene, &camera, depth)
+            }
         }
         .with_cutoff(opts.cutoff);
         Ok(&self.last.insert((Arc::clone(scene), tracer)).1)
     }
+}
+
+/// Whether two scenes compile alike: the same spheres, lights and sky, whatever their
+/// cameras and image settings. Each view comes as a scene of its own (its camera
+/// set), so comparing the `Arc`s compiled every view afresh: 1 ms a view for hw3,
+/// 0.1 s for 100,000 spheres, where the comparison takes well under a millisecond.
+fn same_contents(a: &Arc<Scene>, b: &Arc<Scene>) -> bool {
+    Arc::ptr_eq(a, b) || (a.spheres == b.spheres && a.lights == b.lights && a.sky == b.sky)
 }
 
 /// The buffers of the passes, kept from view to view: a fresh full-size buffer for
@@ -541,6 +554,48 @@ mod tests {
                 "{addresses:?}"
             );
         }
+    }
+
+    #[test]
+    fn views_of_one_scene_compile_it_once() {
+        // Each view comes as a scene of its own with its camera set, as the window
+        // submits them: the spheres are compiled once, and each view still equals a
+        // render of it; a moved sphere is compiled afresh.
+        use crate::viewer::controls::{Action, CameraControl};
+        let mut base = hw3_scene(HW3_DEFAULT_SEED);
+        base.image.spp = 1;
+        let (w, h) = (96, 54);
+        let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
+        let mut camera = CameraControl::new(&base);
+        let mut view = |scene: &Scene, cache: &mut TracerCache, n: u64| {
+            let shown = Mutex::new(Vec::new());
+            let sink = |r: Report| match r {
+                Report::Frame(s) => shown.lock().unwrap().push(s),
+                Report::Failed { message, .. } => panic!("render failed: {message}"),
+            };
+            let job = Job::new(n, Arc::new(scene.clone()), (w, h), 4);
+            run(&job, cache, &mut buffers, &sink).unwrap();
+            let last = shown.into_inner().unwrap().pop().unwrap();
+            let mut opts = RenderOptions::for_scene(scene);
+            (opts.image.width, opts.image.height) = (w, h);
+            let (expected, _) = render::render(scene, &opts, &RenderControl::default()).unwrap();
+            assert_eq!(*last.frame, expected, "view {n}");
+        };
+        let drag = Action::Drag {
+            dx: 40.0,
+            dy: 0.0,
+            height: h,
+        };
+        let mut seen = base.clone();
+        for n in 0..3 {
+            camera.apply(&base, w, h, drag);
+            seen.camera = Some(camera.spec(&base, w, h));
+            view(&seen, &mut cache, n);
+        }
+        assert_eq!(cache.compiles, 1);
+        seen.spheres[3].center.x += 0.25;
+        view(&seen, &mut cache, 3);
+        assert_eq!(cache.compiles, 2);
     }
 
     /// A tracer that cancels its job as soon as it traces.
