@@ -64,8 +64,9 @@ pub fn fill_for_screen(
         });
 }
 
-/// [`fill_for_screen`] for a frame that shows `preview` (rendered at 1/`factor` of
-/// the size) with each of its pixels as a `factor`×`factor` block, anchored at the
+/// [`fill_for_screen`] for a frame that shows `preview` (one-sample values of an
+/// image at 1/`factor` of the size, `width` wide, row 0 at the bottom; non-finite ones
+/// shown as 0) with each of its pixels as a `factor`×`factor` block, anchored at the
 /// bottom-left like the image (a block cut by the top or right edge is cut short; a
 /// `preview` too small for the frame goes on with its last column and row).
 ///
@@ -75,15 +76,16 @@ pub fn fill_for_screen(
 pub fn fill_upscaled_for_screen(
     frame: &mut Frame,
     rgba: &mut Vec<u8>,
-    preview: &Frame,
+    (preview, width): (&[Vec3], u32),
     factor: u32,
 ) {
     let (w, factor) = (frame.width as usize, factor.max(1) as usize);
     let n = w * frame.height as usize;
     frame.pixels.resize(n, Vec3::ZERO);
     rgba.resize(n * 4, 0);
-    let (pw, ph) = (preview.width as usize, preview.height as usize);
-    if n == 0 || pw * ph == 0 {
+    let pw = width as usize;
+    let ph = preview.len().checked_div(pw).unwrap_or(0);
+    if n == 0 || ph == 0 {
         return;
     }
     frame
@@ -94,9 +96,10 @@ pub fn fill_upscaled_for_screen(
         .enumerate()
         .for_each(|(block_row, (pixels, bytes))| {
             let start = block_row.min(ph - 1) * pw;
-            let source = &preview.pixels[start..start + pw];
+            let mut source = preview[start..start + pw].to_vec();
+            crate::render::mend_non_finite(&mut source);
             let mut words = vec![[0u8; 4]; pw];
-            rgba_row(source, words.as_flattened_mut());
+            rgba_row(&source, words.as_flattened_mut());
             let (first, rest) = pixels.split_at_mut(w);
             let (first_bytes, rest_bytes) = bytes.split_at_mut(w * 4);
             // The source column advances every `factor` pixels and stops at the last.
@@ -211,11 +214,12 @@ mod tests {
 
     #[test]
     fn upscaled_previews_repeat_blocks_from_the_bottom_left() {
-        let preview = frame();
+        let mut preview = frame();
         // 5×3 from 3×2 at factor 2: the top row and the right column are half blocks.
         let mut big = Frame::new(5, 3);
         let mut rgba = Vec::new();
-        fill_upscaled_for_screen(&mut big, &mut rgba, &preview, 2);
+        let values = (preview.pixels.as_slice(), preview.width);
+        fill_upscaled_for_screen(&mut big, &mut rgba, values, 2);
         for (i, j, (pi, pj)) in [
             (0, 0, (0, 0)),
             (1, 1, (0, 0)),
@@ -227,10 +231,18 @@ mod tests {
         assert_eq!(rgba, to_rgba_top_down(&big));
         // A preview too small for the frame: its last column and row go on.
         let mut wide = Frame::new(8, 6);
-        fill_upscaled_for_screen(&mut wide, &mut rgba, &preview, 2);
+        fill_upscaled_for_screen(&mut wide, &mut rgba, values, 2);
         assert_eq!(wide.get(7, 5), preview.get(2, 1));
         assert_eq!(wide.get(7, 0), preview.get(2, 0));
         assert_eq!(rgba, to_rgba_top_down(&wide));
+        // A value that is not finite is shown (and kept for `S`) as 0.
+        preview.pixels[4] = Vec3::new(f32::NAN, 0.5, f32::INFINITY);
+        let values = (preview.pixels.as_slice(), preview.width);
+        fill_upscaled_for_screen(&mut big, &mut rgba, values, 2);
+        assert_eq!(big.get(2, 2), Vec3::ZERO);
+        assert_eq!(big.get(3, 2), Vec3::ZERO);
+        assert_eq!(big.get(0, 2), preview.get(0, 1));
+        assert_eq!(rgba, to_rgba_top_down(&big));
     }
 
     #[test]
