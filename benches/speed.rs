@@ -165,7 +165,9 @@ fn viewer(c: &mut Criterion) {
         .expect("renders")
         .0;
     group.bench_function("preview_fill_1280x720_factor_2", |b| {
-        b.iter(|| fill_upscaled_for_screen(&mut frame, &mut rgba, &preview, 2))
+        b.iter(|| {
+            fill_upscaled_for_screen(&mut frame, &mut rgba, (&preview.pixels, preview.width), 2)
+        })
     });
     let mut surface = vec![0u32; (w * h) as usize];
     group.bench_function("blit_xrgb_1280x720", |b| {
