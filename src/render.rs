@@ -419,9 +419,7 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
 /// Divides sums of `samples` samples into pixel values; anything non-finite becomes 0
 /// so that no NaN or infinity can reach a file or the window.
 pub fn resolve(sums: &[Vec3], samples: u32, width: u32, height: u32) -> Frame {
-    // In parallel: serially this was a tenth of a one-sample pass in the viewer. In
-    // runs through `pixel_values`: one sample is a copy (a division a pixel and a
-    // collect cost the viewer's preview 3% of its instructions).
+    // In parallel, in runs through `pixel_values` (for one sample a copy).
     let mut pixels = vec![Vec3::ZERO; sums.len()];
     pixels
         .par_chunks_mut(4096)
@@ -447,10 +445,11 @@ pub fn pixel_values(sums: &[Vec3], samples: u32, out: &mut [Vec3]) {
     mend_non_finite(out);
 }
 
-/// The values of one-sample pixels in place: anything non-finite becomes 0 (looked
-/// for without a branch a pixel).
+/// The values of one-sample pixels in place: anything non-finite becomes 0. Looked
+/// for without a branch a pixel (it never happens in a sound scene): p − p is 0 for a
+/// finite p and NaN otherwise, and a NaN stays in the sum.
 pub fn mend_non_finite(values: &mut [Vec3]) {
-    #[allow(clippy::eq_op)] // p − p is 0 for a finite p and NaN otherwise
+    #[allow(clippy::eq_op)] // p − p is the point
     let poison = values.iter().fold(Vec3::ZERO, |sum, &p| sum + (p - p));
     if poison != Vec3::ZERO {
         for p in values.iter_mut().filter(|p| !p.is_finite()) {
@@ -559,16 +558,7 @@ fn render_with<T: SampleTracer>(
                         // positions worked out once (same values, no division), and
                         // the row at once, which lets the tracer share work.
                         tracer.sample_row(&centres, centre_height(opts, j), row, counts);
-                        // Looked for without a branch a pixel (it never happens in a
-                        // sound scene), mended where it does: p − p is 0 for a finite
-                        // p and NaN otherwise, and a NaN stays in the sum.
-                        #[allow(clippy::eq_op)] // p − p is the point
-                        let poison = row.iter().fold(Vec3::ZERO, |sum, &p| sum + (p - p));
-                        if poison != Vec3::ZERO {
-                            for p in row.iter_mut().filter(|p| !p.is_finite()) {
-                                *p = Vec3::ZERO;
-                            }
-                        }
+                        mend_non_finite(row);
                         return;
                     }
                     for (a, p) in row.iter_mut().enumerate() {

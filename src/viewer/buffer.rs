@@ -96,8 +96,8 @@ pub fn fill_upscaled_for_screen(
         .enumerate()
         .for_each(|(block_row, (pixels, bytes))| {
             let start = block_row.min(ph - 1) * pw;
-            let mut source = preview[start..start + pw].to_vec();
-            crate::render::mend_non_finite(&mut source);
+            let mut source = vec![Vec3::ZERO; pw];
+            crate::render::pixel_values(&preview[start..start + pw], 1, &mut source);
             let mut words = vec![[0u8; 4]; pw];
             rgba_row(&source, words.as_flattened_mut());
             let (first, rest) = pixels.split_at_mut(w);
