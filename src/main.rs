@@ -54,6 +54,11 @@ enum Command {
         /// as the window renders it (no window; the blit is not included).
         #[arg(long, value_name = "VIEWS", value_parser = clap::value_parser!(u32).range(1..=100000))]
         orbit: Option<u32>,
+        /// With --orbit: render each view in one full pass, without the preview the
+        /// window puts first when a frame takes longer than 1/30 s (the render time of
+        /// whole frames).
+        #[arg(long, requires = "orbit")]
+        no_preview: bool,
     },
     /// Measure run time against error over a grid of quality settings on several
     /// scenes; writes bench.csv, bench.md and bench.svg (docs/quality.md).
@@ -208,7 +213,8 @@ fn main() -> ExitCode {
             runs,
             threads,
             orbit,
-        }) => time_command(scene.as_deref(), runs, threads, orbit),
+            no_preview,
+        }) => time_command(scene.as_deref(), runs, threads, orbit, !no_preview),
         Some(Command::Scene { name: _, seed }) => scene_command(seed),
     };
     match result {
@@ -276,6 +282,7 @@ fn time_command(
     runs: usize,
     threads: Option<u32>,
     orbit: Option<u32>,
+    preview: bool,
 ) -> anyhow::Result<()> {
     let scene = load_scene(path)?;
     let name = path.map_or("hw3".to_string(), |p| p.display().to_string());
@@ -285,7 +292,8 @@ fn time_command(
             .num_threads(threads.map_or(0, |t| t as usize))
             .build()
             .context("cannot start the threads")?;
-        let timing = pool.install(|| whitted::speed::time_orbit(&scene, size, views as usize))?;
+        let timing =
+            pool.install(|| whitted::speed::time_orbit(&scene, size, views as usize, preview))?;
         let line = timing.result_line(&name, pool.current_num_threads(), size);
         println!("{line}");
         return Ok(());

@@ -146,11 +146,13 @@ impl OrbitTiming {
 /// `views` times after one warm-up view, and renders each view at `size` exactly as
 /// the viewer's window does — its worker's passes, tracer cache and buffers, its
 /// choice of preview from the speed measured so far — without a window: the render
-/// time per frame of the viewer, apart from the blit.
+/// time per frame of the viewer, apart from the blit. Without `preview`, every view is
+/// one full pass (the window's choice when a frame fits 1/30 s).
 pub fn time_orbit(
     scene: &Scene,
     size: (u32, u32),
     views: usize,
+    preview: bool,
 ) -> Result<OrbitTiming, RenderError> {
     use crate::viewer::controls::{Action, CameraControl};
     use crate::viewer::schedule::{measured_speed, preview_factor};
@@ -183,7 +185,11 @@ pub fn time_orbit(
             view as u64,
             Arc::new(seen),
             size,
-            preview_factor(size.0, size.1, speed),
+            if preview {
+                preview_factor(size.0, size.1, speed)
+            } else {
+                1
+            },
         );
         let reports = std::cell::RefCell::new(Vec::new());
         worker::run(&job, &mut cache, &mut buffers, &|r| {

@@ -359,4 +359,16 @@ fn time_prints_one_result_line_for_renders_and_for_orbits() {
     let fps: f64 = field(&line, "fps").parse().unwrap();
     // A view's time runs from its submission to its frame, so it holds the pass.
     assert!(ms > 0.0 && view_ms >= ms && fps > 0.0, "{line}");
+
+    // Whole frames only: no view starts with a preview, whatever the speed.
+    let out = whitted(&["time", "--orbit", "2", "--no-preview", "--threads", "2"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(field(&line, "size"), "1280x720");
+    assert_eq!(field(&line, "views"), "2");
+    assert_eq!(field(&line, "previews"), "0");
+    // The flag belongs to orbits.
+    let out = whitted(&["time", scene, "--no-preview"]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("--orbit"), "{}", stderr(&out));
 }
