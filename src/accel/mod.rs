@@ -80,12 +80,17 @@ const QUICK_SLACK: f32 = 1.0 / (1 << 18) as f32;
 
 /// Cells per face of the eye's grid: coarser than the lights' below 16k spheres. Its
 /// empty cells let whole runs of sky pixels skip the query (larger cells, more such
-/// runs) while a primary ray's list stays short. Measured (1 thread, best of 21):
-/// hw3 (52 spheres) 0.056 s at 16–32 cells against 0.061 s at 128; many_1000 best at
-/// 32–64 (−4% against 128), many_10000 at 64 (−3%), many_100000 at 256 (128: +7%).
+/// runs, and more runs of pixels in one cell sharing its lookup) while a primary ray's
+/// list stays short. Measured (1 thread, best of 21): hw3 (52 spheres) 0.056 s at
+/// 16–32 cells against 0.061 s at 128; many_1000 best at 32–64 (−4% against 128),
+/// many_10000 at 64 (−3%), many_100000 at 256 (128: +7%). Since the runs share their
+/// cell, instructions (callgrind) of hw3 at 8, 12, 16, 24 and 32 cells: 767.5, 763.1,
+/// 772.1, 778.4 and 795.4 million, and of 40 orbit views 21.32, 21.29, 21.37, – and
+/// 21.78 billion; many_1000 at 32, 48, 64 and 96: 1.029, 0.994, 0.995, 1.009 billion.
 fn eye_resolution(spheres: usize) -> u32 {
     match spheres {
-        0..=256 => 32,
+        0..=64 => 12,
+        65..=256 => 32,
         257..=16384 => 64,
         _ => 256,
     }
