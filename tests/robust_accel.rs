@@ -391,3 +391,93 @@ fn rays_inside_a_sphere_meet_what_brute_force_meets() {
         "too few to say anything: {rays} {ambiguous} {other}"
     );
 }
+
+/// The finest grids (an eye grid for more than 16,384 spheres, the lights' 256-cell
+/// grids): the peers' scene of 20,000 balls on the ground, seen from its camera. Every
+/// primary ray's sphere, and the shadow factor from its hit, equal brute force in
+/// `f64` (ambiguous cases left out and counted, as above).
+#[test]
+fn large_scenes_lose_no_hit_or_occluder() {
+    let scene = whitted::scene::many_scene(20_000);
+    let spheres = &scene.spheres;
+    let light = scene.lights[0].position;
+    let eye = DVec3::new(0.0, 18.0, 60.0);
+    let set = Spheres::new(spheres).with_light_grids(&[light]);
+    let eye_grid = set.eye_grid(eye);
+    // A fixed sequence of rays, each aimed within 1.3 radii of a sphere's centre.
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut tested, mut ambiguous, mut shadows) = (0u32, 0u32, 0u32);
+    let (mut balls, mut shadowed) = (0u32, 0u32);
+    for _ in 0..3000 {
+        let s = &spheres[((next() * spheres.len() as f64) as usize).min(spheres.len() - 1)];
+        let u = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+        let aim = s.center + u * (2.6 * s.radius);
+        let q = Query {
+            origin: eye,
+            dir: (aim - eye).normalize().as_vec3().normalize(),
+            from: None,
+        };
+        let (o, d) = query_ray(&q);
+        let all = crossings(o, d, spheres, None, 0.0);
+        let mut sorted: Vec<_> = all.iter().filter(|x| !x.1.is_nan()).collect();
+        sorted.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let tie = sorted.len() >= 2 && (sorted[1].1 - sorted[0].1) <= 1e-9 * sorted[1].1.abs();
+        if all.iter().any(|x| x.3) || tie {
+            ambiguous += 1;
+            continue;
+        }
+        tested += 1;
+        let want = sorted.first().map(|x| x.0 as u32);
+        let got = set.closest_from_eye(&eye_grid, q.dir);
+        assert_eq!(got.map(|h| h.sphere), want, "ray {q:?}");
+        let Some(hit) = got else { continue };
+        balls += u32::from(hit.sphere >= 4); // not the ground nor the three big balls
+        let to = light - hit.point;
+        let dist = to.length();
+        let sq = Query {
+            origin: hit.point,
+            dir: (to / dist).as_vec3().normalize(),
+            from: Some((hit.sphere, Side::Outward)),
+        };
+        let (so, sd) = query_ray(&sq);
+        let occluders: Vec<_> = crossings(
+            so,
+            sd,
+            spheres,
+            Some((hit.sphere as usize, Side::Outward)),
+            sq.t_min(),
+        )
+        .into_iter()
+        .filter(|x| x.1.is_nan() || x.1 < dist * (1.0 + 1e-7))
+        .collect();
+        if occluders
+            .iter()
+            .any(|x| x.3 || (x.1 - dist).abs() <= 1e-7 * dist)
+        {
+            continue;
+        }
+        shadows += 1;
+        let want = occluders
+            .iter()
+            .map(|x| (1.0 + sd.dot(x.2)) * 0.5)
+            .fold(1.0f64, f64::min);
+        shadowed += u32::from(want < 1.0);
+        let got = set.shadow_to_light(&sq, dist, 0);
+        assert!(
+            (f64::from(got) - want).abs() <= 1e-5,
+            "shadow {got}, f64 says {want}"
+        );
+    }
+    println!(
+        "large scene: {tested} primary rays tested ({ambiguous} ambiguous, {balls} on small \
+         balls), {shadows} shadow rays ({shadowed} shadowed)"
+    );
+    assert!(tested > 2500 && balls > 1000, "{tested} {balls}");
+    assert!(shadows > 1500 && shadowed > 100, "{shadows} {shadowed}");
+}
