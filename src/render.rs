@@ -395,13 +395,7 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
 ) -> Result<RayCounts, RenderError> {
     let area = opts.area();
     if samples == (0..1) {
-        // The first sample: whole rows at once, written in place (`first_samples`, which
-        // the viewer's preview shares).
-        let columns: Vec<u32> = (area.x..area.x + area.width).collect();
-        let centres = centres_of(opts, &columns);
-        return for_each_row(opts, area, sums, 1, 1, control, |j, row, counts| {
-            first_samples(tracer, opts, &columns, &centres, j, row, counts);
-        });
+        return accumulate_first(tracer, opts, sums, control, &|_, _| {});
     }
     let n = samples.len() as u64;
     let afresh = samples.start == 0;
@@ -413,6 +407,25 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
             let (s, t) = film(opts, i, j, k);
             sum[0] += tracer.sample(s, t, counts);
         }
+    })
+}
+
+/// [`accumulate`] of sample 0 alone, calling `after_row(j, row)` with each row once it
+/// is traced (on the thread that traced it): whole rows at once, written in place
+/// (`first_samples`, which the viewer's preview shares).
+pub fn accumulate_first<T: SampleTracer + ?Sized>(
+    tracer: &T,
+    opts: &RenderOptions,
+    sums: &mut [Vec3],
+    control: &RenderControl,
+    after_row: &(dyn Fn(u32, &mut [Vec3]) + Sync),
+) -> Result<RayCounts, RenderError> {
+    let area = opts.area();
+    let columns: Vec<u32> = (area.x..area.x + area.width).collect();
+    let centres = centres_of(opts, &columns);
+    for_each_row(opts, area, sums, 1, 1, control, |j, row, counts| {
+        first_samples(tracer, opts, &columns, &centres, j, row, counts);
+        after_row(j, row);
     })
 }
 

@@ -21,6 +21,35 @@ pub fn to_rgba_top_down(frame: &Frame) -> Vec<u8> {
     bytes
 }
 
+/// The rows of an RGBA buffer (row 0 at the top), for image rows `j` counted from the
+/// bottom, each behind its own lock: a pass converts its rows as it traces them, on
+/// whichever thread traced them, while they are still in cache (a separate fill after
+/// the pass reads the 11 MB frame of 1280×720 again: 1.9 ms on two threads).
+pub struct ScreenRows<'a> {
+    rows: Vec<std::sync::Mutex<&'a mut [u8]>>,
+}
+
+impl<'a> ScreenRows<'a> {
+    /// `rgba` resized for `width`×`height`.
+    pub fn new(rgba: &'a mut Vec<u8>, width: u32, height: u32) -> Self {
+        let w = (width as usize).max(1);
+        rgba.resize(width as usize * height as usize * 4, 0);
+        ScreenRows {
+            rows: rgba
+                .chunks_mut(w * 4)
+                .rev()
+                .map(std::sync::Mutex::new)
+                .collect(),
+        }
+    }
+
+    /// Image row `j` (from the bottom) as RGBA bytes, as [`fill_for_screen`] writes it.
+    pub fn put(&self, j: usize, pixels: &[Vec3]) {
+        let mut row = self.rows[j].lock().unwrap_or_else(|e| e.into_inner());
+        rgba_row(pixels, &mut row);
+    }
+}
+
 /// One row of pixels as RGBA bytes. Not inlined: compiled once, the same code for
 /// every caller (inlined, its cost moved by a quarter with unrelated changes).
 #[inline(never)]

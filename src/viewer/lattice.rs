@@ -79,16 +79,16 @@ pub fn sample_lattice<T: SampleTracer + ?Sized>(
     })?
 }
 
-/// [`render::accumulate`] of sample 0 (`sums` area-sized, row 0 at the bottom) when
-/// `values` (from [`sample_lattice`] of the same tracer and options) already holds the
-/// lattice's: the other pixels are traced, the lattice's copied.
+/// [`render::accumulate_first`] (`sums` area-sized, row 0 at the bottom) when `values`
+/// (from [`sample_lattice`] of the same tracer and options) already holds the
+/// lattice's: the other pixels are traced, the lattice's copied; then `after_row`.
 pub fn accumulate_first_around<T: SampleTracer + ?Sized>(
     tracer: &T,
     opts: &RenderOptions,
-    lattice: Lattice,
-    values: &[Vec3],
+    (lattice, values): (Lattice, &[Vec3]),
     sums: &mut [Vec3],
     control: &RenderControl,
+    after_row: &(dyn Fn(u32, &mut [Vec3]) + Sync),
 ) -> Result<RayCounts, RenderError> {
     let area = opts.area();
     let (bw, bh) = lattice.blocks(area.width, area.height);
@@ -118,6 +118,7 @@ pub fn accumulate_first_around<T: SampleTracer + ?Sized>(
         let r = j - j0;
         if !lattice.holds(r, area.height) {
             render::first_samples(tracer, opts, &all, &all_centres, j, row, counts);
+            after_row(j, row);
             return;
         }
         // Traced into the front of the row, then moved to their places from the last
@@ -139,6 +140,7 @@ pub fn accumulate_first_around<T: SampleTracer + ?Sized>(
         for &(a, b) in &picked_at {
             row[a] = block_row[b];
         }
+        after_row(j, row);
     })
 }
 

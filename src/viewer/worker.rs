@@ -18,7 +18,7 @@ use crate::scene::Scene;
 use crate::trace::fast::FastTracer;
 use crate::trace::SampleTracer;
 
-use super::buffer::{fill_for_screen, fill_upscaled_for_screen};
+use super::buffer::{fill_for_screen, fill_upscaled_for_screen, ScreenRows};
 use super::lattice::{self, Lattice};
 use super::schedule::{plan, Pass};
 
@@ -235,6 +235,11 @@ impl<T> Recycler<T> {
         Arc::try_unwrap(self.sent.remove(free)?).ok()
     }
 
+    /// `value`, taken and not sent, back for a later [`Recycler::take`].
+    fn give_back(&mut self, value: T) {
+        self.sent.push_back(Arc::new(value));
+    }
+
     /// `value`, shared, remembered for a later [`Recycler::take`].
     fn send(&mut self, value: T) -> Arc<T> {
         let shared = Arc::new(value);
@@ -294,77 +299,60 @@ fn passes<T: SampleTracer + ?Sized>(
             return Err(RenderError::Cancelled);
         }
         let start = Instant::now();
-        // The pass is traced first: a cancelled one returns here, before the screen
-        // buffers are taken (taken and dropped, they would not come back).
-        let (samples, pass_pixels, preview) = match pass {
-            Pass::Preview {
-                width,
-                height,
-                factor,
-            } => {
-                // One pixel of each block, as the first full pass would trace it: that
-                // pass then takes these instead of tracing them again.
-                let lattice = Lattice { factor };
-                let values = &mut buffers.preview_sums;
-                values.resize(width as usize * height as usize, Vec3::ZERO);
-                lattice::sample_lattice(tracer, opts, lattice, values, control)?;
-                previewed = Some(lattice);
-                // Shown from the values themselves (no copy resolved into a frame: that
-                // was 0.8 ms a preview, most of it the fresh pages of 2.8 MB).
-                (
-                    0,
-                    u64::from(width) * u64::from(height),
-                    Some((width, factor)),
-                )
-            }
-            Pass::Samples(range) => {
-                let end = range.end;
-                let mut pixels = u64::from(w) * u64::from(h) * range.len() as u64;
-                match previewed.take() {
-                    Some(lattice) if range == (0..1) => {
-                        let values = &buffers.preview_sums;
-                        pixels -= values.len() as u64;
-                        lattice::accumulate_first_around(
-                            tracer,
-                            opts,
-                            lattice,
-                            values,
-                            &mut buffers.sums,
-                            control,
-                        )?;
-                    }
-                    _ => {
-                        render::accumulate(tracer, opts, range, &mut buffers.sums, control)?;
-                    }
+        // The last pass of one sample converts its rows for the screen as it traces
+        // them (its sums are the frame's values); it takes the screen buffer first, and
+        // gives it back if cancelled. Other passes are traced first: a cancelled one
+        // returns before the screen buffers are taken.
+        let last_single = index == last && pass == Pass::Samples(0..1);
+        let mut early_rgba = last_single.then(|| buffers.rgba.take().unwrap_or_default());
+        let traced = trace_pass(
+            tracer,
+            opts,
+            buffers,
+            &mut previewed,
+            pass,
+            early_rgba.as_mut(),
+            control,
+        );
+        let (samples, pass_pixels, preview) = match traced {
+            Ok(done) => done,
+            Err(e) => {
+                if let Some(rgba) = early_rgba {
+                    buffers.rgba.give_back(rgba);
                 }
-                (end, pixels, None)
+                return Err(e);
             }
         };
         let mut frame = buffers.frames.take().unwrap_or_else(|| Frame::new(0, 0));
         (frame.width, frame.height) = (w, h);
-        let mut rgba = buffers.rgba.take().unwrap_or_default();
-        match &preview {
-            Some((width, factor)) => fill_upscaled_for_screen(
-                &mut frame,
-                &mut rgba,
-                (&buffers.preview_sums, *width),
-                *factor,
-            ),
-            None if index == last && samples == 1 => {
-                // The last pass, of one sample: the sums are the frame's values. They
-                // are handed over, not copied (11 MB at 1280×720), and the frame's old
+        let rgba = match early_rgba {
+            Some(rgba) => {
+                // The sums are the frame's values, mended and on the screen already:
+                // handed over, not copied (11 MB at 1280×720), and the frame's old
                 // pixels become the next view's sums.
                 std::mem::swap(&mut frame.pixels, &mut buffers.sums);
-                fill_for_screen(&mut frame, &mut rgba, |_, row| render::mend_non_finite(row));
+                rgba
             }
             None => {
-                let sums = &buffers.sums;
-                fill_for_screen(&mut frame, &mut rgba, |j, row| {
-                    let from = &sums[j * row.len()..(j + 1) * row.len()];
-                    render::pixel_values(from, samples, row);
-                });
+                let mut rgba = buffers.rgba.take().unwrap_or_default();
+                match &preview {
+                    Some((width, factor)) => fill_upscaled_for_screen(
+                        &mut frame,
+                        &mut rgba,
+                        (&buffers.preview_sums, *width),
+                        *factor,
+                    ),
+                    None => {
+                        let sums = &buffers.sums;
+                        fill_for_screen(&mut frame, &mut rgba, |j, row| {
+                            let from = &sums[j * row.len()..(j + 1) * row.len()];
+                            render::pixel_values(from, samples, row);
+                        });
+                    }
+                }
+                rgba
             }
-        }
+        };
         sink(Report::Frame(Shown {
             generation: job.generation,
             frame: buffers.frames.send(frame),
@@ -379,6 +367,73 @@ fn passes<T: SampleTracer + ?Sized>(
         }));
     }
     Ok(())
+}
+
+/// Traces `pass` into the buffers: `(samples so far, pixel-samples traced, the
+/// preview's width and factor)`. With `screen`, a pass of sample 0 also mends each row
+/// and writes it there as RGBA bytes.
+#[allow(clippy::type_complexity)]
+fn trace_pass<T: SampleTracer + ?Sized>(
+    tracer: &T,
+    opts: &RenderOptions,
+    buffers: &mut Buffers,
+    previewed: &mut Option<Lattice>,
+    pass: Pass,
+    screen: Option<&mut Vec<u8>>,
+    control: &RenderControl,
+) -> Result<(u32, u64, Option<(u32, u32)>), RenderError> {
+    let (w, h) = (opts.image.width, opts.image.height);
+    let screen = screen.map(|rgba| ScreenRows::new(rgba, w, h));
+    let after_row = |j: u32, row: &mut [Vec3]| {
+        if let Some(screen) = &screen {
+            render::mend_non_finite(row);
+            screen.put(j as usize, row);
+        }
+    };
+    Ok(match pass {
+        Pass::Preview {
+            width,
+            height,
+            factor,
+        } => {
+            // One pixel of each block, as the first full pass would trace it: that pass
+            // then takes these instead of tracing them again.
+            let lattice = Lattice { factor };
+            let values = &mut buffers.preview_sums;
+            values.resize(width as usize * height as usize, Vec3::ZERO);
+            lattice::sample_lattice(tracer, opts, lattice, values, control)?;
+            *previewed = Some(lattice);
+            // Shown from the values themselves (no copy resolved into a frame: that was
+            // 0.8 ms a preview, most of it the fresh pages of 2.8 MB).
+            (
+                0,
+                u64::from(width) * u64::from(height),
+                Some((width, factor)),
+            )
+        }
+        Pass::Samples(range) => {
+            let end = range.end;
+            let mut pixels = u64::from(w) * u64::from(h) * range.len() as u64;
+            let sums = &mut buffers.sums;
+            match previewed.take() {
+                Some(lattice) if range == (0..1) => {
+                    let values = &buffers.preview_sums;
+                    pixels -= values.len() as u64;
+                    let around = (lattice, values.as_slice());
+                    lattice::accumulate_first_around(
+                        tracer, opts, around, sums, control, &after_row,
+                    )?;
+                }
+                _ if range == (0..1) => {
+                    render::accumulate_first(tracer, opts, sums, control, &after_row)?;
+                }
+                _ => {
+                    render::accumulate(tracer, opts, range, sums, control)?;
+                }
+            };
+            (end, pixels, None)
+        }
+    })
 }
 
 #[cfg(test)]
@@ -617,27 +672,32 @@ mod tests {
 
     #[test]
     fn a_pass_cancelled_midway_keeps_the_buffers() {
-        let mut scene = hw3_scene(HW3_DEFAULT_SEED);
-        scene.image.spp = 2;
-        let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
-        let scene = Arc::new(scene);
-        let first = Job::new(1, Arc::clone(&scene), (192, 108), 4);
-        run(&first, &mut cache, &mut buffers, &|_| {}).unwrap();
-        let pooled = (buffers.frames.sent.len(), buffers.rgba.sent.len());
-        assert!(pooled.0 > 0 && pooled.1 > 0);
-        // The next view is cancelled inside its first pass (its preview).
-        let second = Job::new(2, Arc::clone(&scene), (192, 108), 4);
-        let mut opts = RenderOptions::for_scene(&scene);
-        (opts.image.width, opts.image.height) = (192, 108);
-        let tracer = Cancelling {
-            tracer: cache.tracer(&scene, &opts).unwrap(),
-            control: &second.control,
-        };
-        let shown = |_: Report| panic!("a cancelled pass was shown");
-        let result = passes(&second, &tracer, &opts, &mut buffers, &shown);
-        assert_eq!(result, Err(RenderError::Cancelled));
-        assert_eq!((buffers.frames.sent.len(), buffers.rgba.sent.len()), pooled);
-        assert!(buffers.frames.take().is_some() && buffers.rgba.take().is_some());
+        // Cancelled inside a preview, and inside a last pass of one sample (which takes
+        // the screen buffer before it traces).
+        for (spp, factor) in [(2, 4), (1, 1)] {
+            let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+            scene.image.spp = spp;
+            let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
+            let scene = Arc::new(scene);
+            let first = Job::new(1, Arc::clone(&scene), (192, 108), factor);
+            run(&first, &mut cache, &mut buffers, &|_| {}).unwrap();
+            let pooled = (buffers.frames.sent.len(), buffers.rgba.sent.len());
+            assert!(pooled.0 > 0 && pooled.1 > 0);
+            // The next view is cancelled inside its first pass.
+            let second = Job::new(2, Arc::clone(&scene), (192, 108), factor);
+            let mut opts = RenderOptions::for_scene(&scene);
+            (opts.image.width, opts.image.height) = (192, 108);
+            let tracer = Cancelling {
+                tracer: cache.tracer(&scene, &opts).unwrap(),
+                control: &second.control,
+            };
+            let shown = |_: Report| panic!("a cancelled pass was shown");
+            let result = passes(&second, &tracer, &opts, &mut buffers, &shown);
+            assert_eq!(result, Err(RenderError::Cancelled));
+            let now = (buffers.frames.sent.len(), buffers.rgba.sent.len());
+            assert_eq!(now, pooled, "spp {spp}, preview factor {factor}");
+            assert!(buffers.frames.take().is_some() && buffers.rgba.take().is_some());
+        }
     }
 
     #[test]
