@@ -13,7 +13,7 @@ use glam::DVec3;
 use proptest::prelude::*;
 use robust_support::cases::runner;
 use robust_support::*;
-use whitted::accel::{Query, Spheres};
+use whitted::accel::{Hit, Query, Spheres};
 use whitted::model::Side;
 use whitted::scene::Sphere;
 
@@ -72,6 +72,33 @@ fn crossings(
         }
     }
     out
+}
+
+/// The shadow ray from `hit` towards `light`, its length, and the shadow factor that
+/// brute force in `f64` gives it (`None` when a crossing is too close to call: tangent,
+/// or at an end of the segment).
+fn shadow_case(spheres: &[Sphere], hit: &Hit, light: DVec3) -> (Query, f64, Option<f64>) {
+    let to = light - hit.point;
+    let dist = to.length();
+    let sq = Query {
+        origin: hit.point,
+        dir: (to / dist).as_vec3().normalize(),
+        from: Some((hit.sphere, Side::Outward)),
+    };
+    let (so, sd) = query_ray(&sq);
+    let own = Some((hit.sphere as usize, Side::Outward));
+    let occluders: Vec<_> = crossings(so, sd, spheres, own, sq.t_min())
+        .into_iter()
+        .filter(|x| x.1.is_nan() || x.1 < dist * (1.0 + 1e-7))
+        .collect();
+    let doubtful = occluders
+        .iter()
+        .any(|x| x.3 || (x.1 - dist).abs() <= 1e-7 * dist);
+    let factor = occluders
+        .iter()
+        .map(|x| (1.0 + sd.dot(x.2)) * 0.5)
+        .fold(1.0f64, f64::min);
+    (sq, dist, (!doubtful).then_some(factor))
 }
 
 #[derive(Default, Debug)]
@@ -153,36 +180,12 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                     // A shadow ray from the hit towards the light, through grid and BVH.
                     let Some(hit) = set.closest(&q) else { continue };
                     c.hits += 1;
-                    let to = light - hit.point;
-                    let dist = to.length();
-                    let sq = Query {
-                        origin: hit.point,
-                        dir: (to / dist).as_vec3().normalize(),
-                        from: Some((hit.sphere, Side::Outward)),
-                    };
-                    let (so, sd) = query_ray(&sq);
-                    let occluders: Vec<_> = crossings(
-                        so,
-                        sd,
-                        &spheres,
-                        Some((hit.sphere as usize, Side::Outward)),
-                        sq.t_min(),
-                    )
-                    .into_iter()
-                    .filter(|x| x.1.is_nan() || x.1 < dist * (1.0 + 1e-7))
-                    .collect();
+                    let (sq, dist, want) = shadow_case(&spheres, &hit, light);
                     c.shadow_rays += 1;
-                    let doubtful = occluders
-                        .iter()
-                        .any(|x| x.3 || (x.1 - dist).abs() <= 1e-7 * dist);
-                    if doubtful {
+                    let Some(want) = want else {
                         c.shadow_ambiguous += 1;
                         continue;
-                    }
-                    let want = occluders
-                        .iter()
-                        .map(|x| (1.0 + sd.dot(x.2)) * 0.5)
-                        .fold(1.0f64, f64::min);
+                    };
                     c.shadowed += u64::from(want < 1.0);
                     let pair = set.shadow_to_light_pair((&sq, dist), (&sq, dist), 0);
                     for (name, got) in [
@@ -438,35 +441,9 @@ fn large_scenes_lose_no_hit_or_occluder() {
         assert_eq!(got.map(|h| h.sphere), want, "ray {q:?}");
         let Some(hit) = got else { continue };
         balls += u32::from(hit.sphere >= 4); // not the ground nor the three big balls
-        let to = light - hit.point;
-        let dist = to.length();
-        let sq = Query {
-            origin: hit.point,
-            dir: (to / dist).as_vec3().normalize(),
-            from: Some((hit.sphere, Side::Outward)),
-        };
-        let (so, sd) = query_ray(&sq);
-        let occluders: Vec<_> = crossings(
-            so,
-            sd,
-            spheres,
-            Some((hit.sphere as usize, Side::Outward)),
-            sq.t_min(),
-        )
-        .into_iter()
-        .filter(|x| x.1.is_nan() || x.1 < dist * (1.0 + 1e-7))
-        .collect();
-        if occluders
-            .iter()
-            .any(|x| x.3 || (x.1 - dist).abs() <= 1e-7 * dist)
-        {
-            continue;
-        }
+        let (sq, dist, want) = shadow_case(spheres, &hit, light);
+        let Some(want) = want else { continue };
         shadows += 1;
-        let want = occluders
-            .iter()
-            .map(|x| (1.0 + sd.dot(x.2)) * 0.5)
-            .fold(1.0f64, f64::min);
         shadowed += u32::from(want < 1.0);
         let got = set.shadow_to_light(&sq, dist, 0);
         assert!(
