@@ -333,20 +333,21 @@ fn build_node(
     if items.len() <= MAX_LEAF {
         return me;
     }
-    // Deep in the tree, split at the median so that the depth stays within the stack.
-    let split = if depth < MAX_SAH_DEPTH {
+    let sah = if depth < MAX_SAH_DEPTH {
         best_split(boxes, centres, items, &centre_bounds, &bounds)
     } else {
-        let axis = (centre_bounds.max - centre_bounds.min).max_position();
-        Some((axis, f32::NAN)) // NaN: nothing goes left, so the count split below applies
+        None
     };
-    // No split beats a leaf, or the centres coincide: a leaf, unless too large for one.
-    let split = split.or_else(|| {
+    // Otherwise a split by count (at NaN nothing goes left, so the count split below
+    // applies): deep in the tree, so that the depth stays within the stack, and for a
+    // set too large for a leaf (spheres with one centre); else a leaf.
+    let by_count = depth >= MAX_SAH_DEPTH || items.len() > LARGEST_LEAF;
+    let split = sah.or_else(|| {
         let axis = (centre_bounds.max - centre_bounds.min).max_position();
-        (items.len() > LARGEST_LEAF).then_some((axis, f32::NAN))
+        by_count.then_some((axis, f32::NAN))
     });
     let Some((axis, split)) = split else {
-        return me;
+        return me; // no split beats a leaf
     };
     let mid = partition(items, |i| centres[i as usize][axis] < split);
     // Degenerate partitions (all centres equal on the axis) split by count.

@@ -81,15 +81,14 @@ pub fn fill_for_screen(
     let w = (frame.width as usize).max(1);
     let n = frame.width as usize * frame.height as usize;
     frame.pixels.resize(n, Vec3::ZERO);
-    rgba.resize(n * 4, 0);
+    let screen = ScreenRows::new(rgba, frame.width, frame.height);
     frame
         .pixels
         .par_chunks_mut(w)
-        .zip(rgba.par_chunks_mut(w * 4).rev())
         .enumerate()
-        .for_each(|(j, (pixels, out))| {
+        .for_each(|(j, pixels)| {
             row(j, pixels);
-            rgba_row(pixels, out);
+            screen.put(j, pixels);
         });
 }
 
@@ -123,30 +122,32 @@ pub fn fill_upscaled_for_screen(
         // Screen rows run top-down: the bottom row of blocks is at the end.
         .zip(rgba.par_rchunks_mut(w * 4 * factor))
         .enumerate()
-        .for_each(|(block_row, (pixels, bytes))| {
-            let start = block_row.min(ph - 1) * pw;
-            let mut source = vec![Vec3::ZERO; pw];
-            crate::render::pixel_values(&preview[start..start + pw], 1, &mut source);
-            let mut words = vec![[0u8; 4]; pw];
-            rgba_row(&source, words.as_flattened_mut());
-            let (first, rest) = pixels.split_at_mut(w);
-            let (first_bytes, rest_bytes) = bytes.split_at_mut(w * 4);
-            // The source column advances every `factor` pixels and stops at the last.
-            let (mut from, mut left) = (0, factor);
-            for (p, o) in first.iter_mut().zip(first_bytes.as_chunks_mut::<4>().0) {
-                (*p, *o) = (source[from], words[from]);
-                left -= 1;
-                if left == 0 {
-                    (from, left) = ((from + 1).min(pw - 1), factor);
+        // A row of blocks' values and bytes, in buffers kept by each thread.
+        .for_each_init(
+            || (vec![Vec3::ZERO; pw], vec![[0u8; 4]; pw]),
+            |(source, words), (block_row, (pixels, bytes))| {
+                let start = block_row.min(ph - 1) * pw;
+                crate::render::pixel_values(&preview[start..start + pw], 1, source);
+                rgba_row(source, words.as_flattened_mut());
+                let (first, rest) = pixels.split_at_mut(w);
+                let (first_bytes, rest_bytes) = bytes.split_at_mut(w * 4);
+                // The source column advances every `factor` pixels and stops at the last.
+                let (mut from, mut left) = (0, factor);
+                for (p, o) in first.iter_mut().zip(first_bytes.as_chunks_mut::<4>().0) {
+                    (*p, *o) = (source[from], words[from]);
+                    left -= 1;
+                    if left == 0 {
+                        (from, left) = ((from + 1).min(pw - 1), factor);
+                    }
                 }
-            }
-            for row in rest.chunks_mut(w) {
-                row.copy_from_slice(first);
-            }
-            for row in rest_bytes.chunks_mut(w * 4) {
-                row.copy_from_slice(first_bytes);
-            }
-        });
+                for row in rest.chunks_mut(w) {
+                    row.copy_from_slice(first);
+                }
+                for row in rest_bytes.chunks_mut(w * 4) {
+                    row.copy_from_slice(first_bytes);
+                }
+            },
+        );
 }
 
 /// Where a `w`×`h` image sits, centred, in a `surface_w`×`surface_h` surface: the
