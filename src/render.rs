@@ -276,6 +276,12 @@ where
         states
             .par_chunks_mut(row_len * BAND_ROWS)
             .enumerate()
+            // Every band a task of its own. Left to itself, rayon cuts the range into a
+            // few pieces and splits a piece further only when it is stolen: on two
+            // threads, the half of an image whose rows cost more (balls below a sky)
+            // went to one thread in pieces too large to share, and the other idled
+            // (many_10000: two threads 1.40x as fast as one; 1.88x so).
+            .with_max_len(1)
             .map(|(band, rows)| {
                 let mut counts = RayCounts::default();
                 for (r, states) in rows.chunks_mut(row_len).enumerate() {

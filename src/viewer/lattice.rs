@@ -60,6 +60,7 @@ pub fn sample_lattice<T: SampleTracer + ?Sized>(
     render::in_pool(opts, || {
         out.par_chunks_mut(bw as usize)
             .enumerate()
+            .with_max_len(1) // every row a task, as `render`'s bands (see there)
             .map(|(b, row)| {
                 if control.is_cancelled() {
                     return Err(RenderError::Cancelled);
