@@ -521,7 +521,8 @@ pub fn render_bounded(
 ) -> Result<Rendered, RenderError> {
     opts.check()?;
     let start = Instant::now();
-    let tracer = Tracer::new(scene, opts)?;
+    // The build runs on the render's threads too: `--threads 1` means one thread.
+    let tracer = in_pool(opts, || Tracer::new(scene, opts))??;
     let build_seconds = start.elapsed().as_secs_f64();
     let (frame, cutoff_bound, refined, rays) = match &tracer {
         Tracer::Fast(t) => render_with(t, opts, control)?,
