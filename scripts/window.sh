@@ -18,7 +18,8 @@ SCENE=${SCENE:-}
 BLIT=${BLIT:-softbuffer}
 cargo build --release --quiet
 work=$(mktemp -d)
-trap 'kill "$app" "$xvfb" 2>/dev/null || true; rm -rf "$work"' EXIT
+app="" xvfb=""
+trap 'kill $app $xvfb 2>/dev/null || true; rm -rf "$work"' EXIT
 display=:$((50 + $$ % 200))
 Xvfb "$display" -screen 0 1600x900x24 -nolisten tcp >/dev/null 2>&1 &
 xvfb=$!
