@@ -271,9 +271,35 @@ where
     );
     // The area's bottom row, counted from the image's bottom.
     let j0 = opts.image.height - (area.y + area.height);
-    let row_len = aw * per_pixel;
-    let mut work = || {
-        states
+    let progress = aw as u64 * samples;
+    for_each_band(
+        opts,
+        states,
+        aw * per_pixel,
+        progress,
+        control,
+        |r, states, counts| row(j0 + r as u32, states, counts),
+    )
+}
+
+/// Runs `row(r, items, counts)` for each row `r` of `items` (rows of `row_len` items)
+/// on the threads of `opts`, in bands of [`BAND_ROWS`] rows, until `control` is
+/// cancelled; each row done adds `progress` to the progress count.
+pub(crate) fn for_each_band<T, F>(
+    opts: &RenderOptions,
+    items: &mut [T],
+    row_len: usize,
+    progress: u64,
+    control: &RenderControl,
+    row: F,
+) -> Result<RayCounts, RenderError>
+where
+    T: Send,
+    F: Fn(usize, &mut [T], &mut RayCounts) + Sync,
+{
+    let row_len = row_len.max(1);
+    in_pool(opts, || {
+        items
             .par_chunks_mut(row_len * BAND_ROWS)
             .enumerate()
             // Every band a task of its own. Left to itself, rayon cuts the range into a
@@ -284,15 +310,12 @@ where
             .with_max_len(1)
             .map(|(band, rows)| {
                 let mut counts = RayCounts::default();
-                for (r, states) in rows.chunks_mut(row_len).enumerate() {
+                for (r, items) in rows.chunks_mut(row_len).enumerate() {
                     if control.is_cancelled() {
                         return Err(RenderError::Cancelled);
                     }
-                    let j = j0 + (band * BAND_ROWS + r) as u32;
-                    row(j, states, &mut counts);
-                    control
-                        .pixels_done
-                        .fetch_add(aw as u64 * samples, Ordering::Relaxed);
+                    row(band * BAND_ROWS + r, items, &mut counts);
+                    control.pixels_done.fetch_add(progress, Ordering::Relaxed);
                 }
                 Ok(counts)
             })
@@ -300,11 +323,7 @@ where
                 a.add(&b);
                 Ok(a)
             })
-    };
-    match opts.threads {
-        None => work(),
-        Some(n) => thread_pool(n)?.install(work),
-    }
+    })?
 }
 
 /// Runs `work` on the threads `opts` asks for.

@@ -7,7 +7,6 @@
 //! row of positions what `sample` gives it).
 
 use glam::Vec3;
-use rayon::prelude::*;
 
 use crate::render::{self, RenderControl, RenderError, RenderOptions};
 use crate::trace::{RayCounts, SampleTracer};
@@ -57,27 +56,18 @@ pub fn sample_lattice<T: SampleTracer + ?Sized>(
     let centres = render::centres_of(opts, &columns);
     // The area's bottom row, counted from the image's bottom.
     let j0 = opts.image.height - (area.y + area.height);
-    render::in_pool(opts, || {
-        out.par_chunks_mut(bw as usize)
-            .enumerate()
-            .with_max_len(1) // every row a task, as `render`'s bands (see there)
-            .map(|(b, row)| {
-                if control.is_cancelled() {
-                    return Err(RenderError::Cancelled);
-                }
-                let mut counts = RayCounts::default();
-                let j = j0 + lattice.pick(b as u32, area.height);
-                render::first_samples(tracer, opts, &columns, &centres, j, row, &mut counts);
-                control
-                    .pixels_done
-                    .fetch_add(u64::from(bw), std::sync::atomic::Ordering::Relaxed);
-                Ok(counts)
-            })
-            .try_reduce(RayCounts::default, |mut a, b| {
-                a.add(&b);
-                Ok(a)
-            })
-    })?
+    let progress = u64::from(bw);
+    render::for_each_band(
+        opts,
+        out,
+        bw as usize,
+        progress,
+        control,
+        |b, row, counts| {
+            let j = j0 + lattice.pick(b as u32, area.height);
+            render::first_samples(tracer, opts, &columns, &centres, j, row, counts);
+        },
+    )
 }
 
 /// [`render::accumulate_first`] (`sums` area-sized, row 0 at the bottom) when `values`
