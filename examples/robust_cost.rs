@@ -1,4 +1,4 @@
-//! What the robust intersection and spawn cost (issue 4), measured in one run on the
+//! What the robust intersection and spawn cost, measured in one run on the
 //! hw3 scene's rays: nanoseconds per ray–sphere test for the assignment's textbook `f32`
 //! form against the stable form in `f32` and in `f64` (what `accel` uses), and
 //! nanoseconds per query for primary, spawned (reflected, with the own-sphere rule and

@@ -27,7 +27,7 @@ EMBREE=$(ls "$OUT"/bin/embree_rays.* 2>/dev/null | tail -1 || true)
 for scene in hw3 $(for n in $MANY; do echo "many_$n"; done); do
     for t in $THREADS; do
         if [ -n "$EMBREE" ]; then
-            # As many runs as whitted's: the RESULT line of the median run (the issue's
+            # As many runs as whitted's: the RESULT line of the median run (the speed
             # targets compare medians), with the best of them added as best_s.
             lines=""
             for _ in $(seq "$RUNS"); do

@@ -247,8 +247,8 @@ impl FastTracer {
     /// so that the two chains of square roots, divisions and loads overlap. The sums
     /// are `shade`'s, term for term.
     ///
-    /// The hits come by reference: moved by value, the pair went through the stack
-    /// whenever the compiler's inlining shifted (+2.7% instructions on hw3).
+    /// The hits come by reference: moved by value, the pair goes through the stack
+    /// whenever the compiler's inlining shifts (2.7% more instructions on hw3).
     fn shade_pair(
         &self,
         dirs: [Vec3; 2],

@@ -51,7 +51,7 @@ impl Blitter {
     /// `pixels` on a GPU; when it fails, or when the adapter wgpu picks is a CPU
     /// rasterizer (llvmpipe, lavapipe: wgpu prefers any GPU to those), the reason is
     /// printed and `softbuffer` used instead. On a CPU, `pixels` draws each 1280×720
-    /// frame in ~15 ms of the cores the render needs, `softbuffer` in ~2 ms.
+    /// frame in ~15 ms of the cores the render needs, `softbuffer` in ~1 ms.
     pub fn new(window: &Arc<Window>, size: (u32, u32), choice: Choice) -> Result<Blitter, String> {
         match choice {
             Choice::Pixels => Self::pixels(window, size),

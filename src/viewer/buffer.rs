@@ -10,7 +10,7 @@ use crate::image_io::to_byte;
 use crate::render::Frame;
 
 /// The frame as RGBA bytes, row 0 at the top, alpha 255 (the layout of `pixels`).
-/// Rows in parallel: serially this took a fifth of a full-resolution pass.
+/// Rows in parallel: serially the conversion costs a fifth of a full-resolution pass.
 pub fn to_rgba_top_down(frame: &Frame) -> Vec<u8> {
     let w = (frame.width as usize).max(1);
     let mut bytes = vec![0u8; frame.pixels.len() * 4];
@@ -51,7 +51,8 @@ impl<'a> ScreenRows<'a> {
 }
 
 /// One row of pixels as RGBA bytes. Not inlined: compiled once, the same code for
-/// every caller (inlined, its cost moved by a quarter with unrelated changes).
+/// every caller (inlined, its code follows each caller's, and its cost shifts by up to
+/// a quarter with unrelated edits).
 #[inline(never)]
 fn rgba_row(pixels: &[Vec3], out: &mut [u8]) {
     let (out, _) = out.as_chunks_mut::<4>();
@@ -99,8 +100,9 @@ pub fn fill_for_screen(
 /// `preview` too small for the frame goes on with its last column and row).
 ///
 /// A row of blocks at a time: each preview pixel is converted to bytes once, not once
-/// a pixel of its block, and the block's first row is copied into the others (the
-/// conversion and a division a pixel had been a sixth of a preview's time).
+/// a pixel of its block, and the block's first row is copied into the others
+/// (converting every pixel of a block, with a division a pixel, costs a sixth of a
+/// preview's time).
 pub fn fill_upscaled_for_screen(
     frame: &mut Frame,
     rgba: &mut Vec<u8>,
