@@ -7,14 +7,14 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{DVec3, Vec3};
 use whitted::accel::{Query, Spheres};
-use whitted::render::{render, RenderControl, RenderOptions};
+use whitted::render::{render, RenderControl};
 use whitted::scene::{hw3_scene, many_scene, HW3_DEFAULT_SEED};
 use whitted::trace::intersect::roots;
 
 /// Rays from the hw3 camera through a grid of film positions.
 fn hw3_rays(n: u32) -> Vec<Vec3> {
     let scene = hw3_scene(HW3_DEFAULT_SEED);
-    let cam = whitted::Camera::for_scene(&scene, 1280, 720).expect("camera");
+    let cam = scene.camera(1280, 720).expect("camera");
     (0..n * n)
         .map(|k| {
             let (s, t) = ((k % n) as f64 / n as f64, (k / n) as f64 / n as f64);
@@ -77,7 +77,7 @@ fn build(c: &mut Criterion) {
     group.sample_size(10);
     for n in [10_000, 100_000] {
         let scene = many_scene(n);
-        let cam = whitted::Camera::for_scene(&scene, 1280, 720).expect("camera");
+        let cam = scene.camera(1280, 720).expect("camera");
         let lights: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
         group.bench_function(format!("bvh_and_grids_many_{n}"), |b| {
             b.iter(|| {
@@ -93,7 +93,7 @@ fn frames(c: &mut Criterion) {
     let mut group = c.benchmark_group("frame");
     group.sample_size(10);
     for scene in [hw3_scene(HW3_DEFAULT_SEED), many_scene(10_000)] {
-        let opts = RenderOptions::for_scene(&scene);
+        let opts = scene.settings();
         let control = RenderControl::default();
         group.bench_function(format!("{}_1280x720", scene.name), |b| {
             b.iter(|| black_box(render(&scene, &opts, &control).expect("renders")))
@@ -113,7 +113,7 @@ fn viewer(c: &mut Criterion) {
 
     let (w, h) = (1280, 720);
     let mut scene = hw3_scene(HW3_DEFAULT_SEED);
-    scene.image.spp = 1;
+    scene.image.spp = Some(1);
     // Views 25 and 26 of `whitted time --orbit`, in turn: each iteration is a new
     // camera, so its eye grid is built as in a drag.
     let mut camera = CameraControl::new(&scene);
@@ -143,13 +143,9 @@ fn viewer(c: &mut Criterion) {
         })
     });
 
-    let image = render(
-        &scene,
-        &RenderOptions::for_scene(&scene),
-        &RenderControl::default(),
-    )
-    .expect("renders")
-    .0;
+    let image = render(&scene, &scene.settings(), &RenderControl::default())
+        .expect("renders")
+        .0;
     let (mut frame, mut rgba) = (Frame::new(w, h), Vec::new());
     group.bench_function("screen_fill_1280x720", |b| {
         b.iter(|| {
@@ -159,8 +155,8 @@ fn viewer(c: &mut Criterion) {
             })
         })
     });
-    let mut small = RenderOptions::for_scene(&scene);
-    (small.image.width, small.image.height) = (w / 2, h / 2);
+    let mut small = scene.settings();
+    (small.width, small.height) = (w / 2, h / 2);
     let preview = render(&scene, &small, &RenderControl::default())
         .expect("renders")
         .0;

@@ -5,7 +5,7 @@ fn main() {
         .nth(1)
         .map_or(100_000, |a| a.parse().expect("a count"));
     let scene = whitted::scene::many_scene(n);
-    let opts = whitted::RenderOptions::for_scene(&scene);
+    let opts = scene.settings();
     let (_, stats) = whitted::render(&scene, &opts, &Default::default()).expect("renders");
     println!(
         "{n} spheres: {:.3} s ({:.3} s build), {} rays",

@@ -12,7 +12,6 @@ use std::time::Instant;
 
 use glam::{DVec3, Vec3};
 use whitted::accel::{Query, Spheres};
-use whitted::camera::Camera;
 use whitted::model::{self, Side};
 use whitted::scene::hw3_scene;
 use whitted::trace::intersect::roots;
@@ -51,7 +50,7 @@ fn textbook(o: Vec3, d: Vec3, c: Vec3, r: f32) -> Option<f32> {
 fn main() {
     let scene = hw3_scene(whitted::scene::HW3_DEFAULT_SEED);
     let (w, h) = (640u32, 360u32);
-    let camera = Camera::for_scene(&scene, w, h).unwrap();
+    let camera = scene.camera(w, h).unwrap();
     let dirs: Vec<Vec3> = (0..h)
         .flat_map(|j| (0..w).map(move |i| (i, j)))
         .map(|(i, j)| {

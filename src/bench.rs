@@ -13,9 +13,10 @@ use anyhow::{bail, Context};
 use glam::{DVec3, Vec3};
 
 use crate::image_io::{to_byte, to_rgb8};
-use crate::quality::{Adaptive, Preset, Quality};
-use crate::render::{render_bounded, Frame, RenderControl, RenderOptions, Renderer};
+use crate::render::{render_bounded, Frame, RenderControl};
 use crate::scene::{hw3_scene, many_scene, Scene, HW3_DEFAULT_SEED};
+use crate::settings::{Adaptive, Preset, Quality};
+use crate::settings::{Precision, Settings};
 
 /// A scene of the study.
 #[derive(Clone, Debug)]
@@ -80,7 +81,7 @@ fn fast(spp: u32, threshold: Option<f32>, cutoff: f32, max_depth: u32) -> Qualit
         adaptive: threshold.map(Adaptive::with_threshold),
         cutoff,
         max_depth,
-        precision: Renderer::Fast,
+        precision: Precision::Fast,
     }
 }
 
@@ -122,7 +123,7 @@ pub fn grid(tiny: bool) -> Vec<Setting> {
         qs.push(fast(64, Some(0.03), 0.0, 16));
         qs.push(fast(64, Some(0.01), 0.0, 16));
         qs.push(Quality {
-            precision: Renderer::Reference,
+            precision: Precision::Reference,
             ..fast(1, None, 0.0, 5)
         });
     }
@@ -280,10 +281,10 @@ impl Row {
     }
 }
 
-fn precision_name(r: Renderer) -> &'static str {
+fn precision_name(r: Precision) -> &'static str {
     match r {
-        Renderer::Fast => "f32",
-        Renderer::Reference => "f64",
+        Precision::Fast => "f32",
+        Precision::Reference => "f64",
     }
 }
 
@@ -297,10 +298,13 @@ fn render_once(
     quality: &Quality,
     opts: &BenchOptions,
 ) -> anyhow::Result<(Frame, f64, f64, u64, f64)> {
-    let mut ro = RenderOptions::for_scene(scene).with_quality(quality);
-    ro.image.width = opts.width;
-    ro.image.height = opts.height;
-    ro.threads = opts.threads;
+    let ro = Settings {
+        width: opts.width,
+        height: opts.height,
+        quality: *quality,
+        threads: opts.threads,
+        ..scene.settings()
+    };
     let r = render_bounded(scene, &ro, &RenderControl::default())
         .with_context(|| format!("{}: {}", scene.name, quality.label()))?;
     let bound = r.cutoff_bound.iter().fold(0.0f32, |m, &b| m.max(b));
@@ -555,7 +559,7 @@ pub fn fixed_spp_time_for(rows: &[Row], scene: &str, max_depth: u32, rmse: f64) 
                 && q.adaptive.is_none()
                 && q.cutoff == 0.0
                 && q.max_depth == max_depth
-                && q.precision == Renderer::Fast
+                && q.precision == Precision::Fast
         })
         .map(|r| (r.errors.rmse, r.median_s))
         .collect();
@@ -583,7 +587,7 @@ pub fn knee<'a>(rows: &'a [Row], scene: &str) -> Option<&'a Row> {
         .filter(|r| {
             r.scene == scene
                 && r.pareto
-                && r.setting.quality.precision == Renderer::Fast
+                && r.setting.quality.precision == Precision::Fast
                 && r.median_s >= plain.median_s
                 && r.errors.rmse <= plain.errors.rmse
         })
@@ -768,7 +772,7 @@ fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
             let q = &r.setting.quality;
             if r.setting.preset.is_some() {
                 RED
-            } else if q.precision == Renderer::Reference {
+            } else if q.precision == Precision::Reference {
                 BLACK
             } else if q.adaptive.is_some() {
                 GREEN

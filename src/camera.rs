@@ -4,18 +4,106 @@
 
 use glam::DVec3;
 
-use crate::scene::{CameraSpec, Scene};
+/// The assignment's vertical field of view, `2·atan(2.25)` in degrees (≈ 132.075°):
+/// at 16:9 it gives the spans `H = (8,0,0)`, `V = (0,4.5,0)`.
+pub fn assignment_vfov_degrees() -> f64 {
+    2.0 * 2.25f64.atan().to_degrees()
+}
 
+/// The two ways a scene may place the camera (SPEC §2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CameraSpec {
+    /// From a point towards another, `up` giving the roll.
+    LookAt {
+        /// The eye.
+        look_from: DVec3,
+        /// A point the view centres on.
+        look_at: DVec3,
+        /// Which way is up (need not be perpendicular to the view).
+        up: DVec3,
+        /// Vertical field of view in degrees.
+        vfov: f64,
+    },
+    /// The film given directly, as the assignment did.
+    Frame {
+        /// The eye `O`.
+        origin: DVec3,
+        /// Lower-left corner `LL` of the film.
+        lower_left: DVec3,
+        /// Horizontal span `H`.
+        horizontal: DVec3,
+        /// Vertical span `V`.
+        vertical: DVec3,
+    },
+}
+
+impl CameraSpec {
+    /// The assignment's look-at form: from the origin towards −z, `vfov = 2·atan(2.25)`.
+    pub fn assignment_look_at() -> Self {
+        CameraSpec::LookAt {
+            look_from: DVec3::ZERO,
+            look_at: DVec3::new(0.0, 0.0, -1.0),
+            up: DVec3::Y,
+            vfov: assignment_vfov_degrees(),
+        }
+    }
+
+    /// The assignment's exact frame (meant for 16:9 images).
+    pub fn assignment_frame() -> Self {
+        CameraSpec::Frame {
+            origin: DVec3::ZERO,
+            lower_left: DVec3::new(-4.0, -2.25, -1.0),
+            horizontal: DVec3::new(8.0, 0.0, 0.0),
+            vertical: DVec3::new(0.0, 4.5, 0.0),
+        }
+    }
+
+    /// Checks for the degenerate cases of SPEC §3.
+    pub fn check(&self) -> Result<(), CameraError> {
+        check_spec(self)
+    }
+}
+
+/// A camera that cannot make an image (SPEC §3).
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum CameraError {
+    /// `look_from = look_at`, or points so far apart the distance overflows.
+    #[error("look_from and look_at must be different points")]
+    SamePoints,
+    /// `up = 0`.
+    #[error("up must not be the zero vector")]
+    ZeroUp,
+    /// `up` along the view direction: no roll can be derived.
+    #[error("up is parallel to the view direction")]
+    UpParallel,
+    /// A field of view outside (0, 180) degrees.
+    #[error("vfov must lie strictly between 0 and 180 degrees, got {0}")]
+    Vfov(f64),
+    /// A zero span of the film.
+    #[error("horizontal and vertical spans must not be zero")]
+    ZeroSpan,
+    /// Spans along one line: the film has no area.
+    #[error("horizontal and vertical spans are parallel")]
+    ParallelSpans,
+    /// Spans that overflow at this image size.
+    #[error("the camera's spans are not finite")]
+    NotFinite,
+}
+
+/// The pinhole camera: eye and film (SPEC §2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// The eye `O`.
     pub origin: DVec3,
+    /// Lower-left corner `LL` of the film.
     pub lower_left: DVec3,
+    /// Horizontal span `H`.
     pub horizontal: DVec3,
+    /// Vertical span `V`.
     pub vertical: DVec3,
 }
 
-/// Checks a camera spec for the degenerate cases of SPEC §3.
-pub fn check_spec(spec: &CameraSpec) -> Result<(), String> {
+fn check_spec(spec: &CameraSpec) -> Result<(), CameraError> {
     match *spec {
         CameraSpec::LookAt {
             look_from,
@@ -25,21 +113,19 @@ pub fn check_spec(spec: &CameraSpec) -> Result<(), String> {
         } => {
             let forward = look_at - look_from;
             if forward.length_squared() == 0.0 || !forward.length_squared().is_finite() {
-                return Err("look_from and look_at must be different points".into());
+                return Err(CameraError::SamePoints);
             }
             if up.length_squared() == 0.0 {
-                return Err("up must not be the zero vector".into());
+                return Err(CameraError::ZeroUp);
             }
             // Parallel within rounding: the cross product is tiny next to the lengths.
             let w = forward.normalize();
             let side = up.normalize().cross(w);
             if side.length() < 1e-9 {
-                return Err("up is parallel to the view direction".into());
+                return Err(CameraError::UpParallel);
             }
             if !(vfov > 0.0 && vfov < 180.0) {
-                return Err(format!(
-                    "vfov must lie strictly between 0 and 180 degrees, got {vfov}"
-                ));
+                return Err(CameraError::Vfov(vfov));
             }
             Ok(())
         }
@@ -49,12 +135,12 @@ pub fn check_spec(spec: &CameraSpec) -> Result<(), String> {
             ..
         } => {
             if horizontal.length_squared() == 0.0 || vertical.length_squared() == 0.0 {
-                return Err("horizontal and vertical spans must not be zero".into());
+                return Err(CameraError::ZeroSpan);
             }
             if horizontal.cross(vertical).length()
                 <= 1e-12 * horizontal.length() * vertical.length()
             {
-                return Err("horizontal and vertical spans are parallel".into());
+                return Err(CameraError::ParallelSpans);
             }
             Ok(())
         }
@@ -63,7 +149,7 @@ pub fn check_spec(spec: &CameraSpec) -> Result<(), String> {
 
 impl Camera {
     /// The camera for an image of `width`×`height` pixels.
-    pub fn new(spec: &CameraSpec, width: u32, height: u32) -> Result<Camera, String> {
+    pub fn new(spec: &CameraSpec, width: u32, height: u32) -> Result<Camera, CameraError> {
         check_spec(spec)?;
         let camera = match *spec {
             CameraSpec::LookAt {
@@ -105,14 +191,9 @@ impl Camera {
         .iter()
         .all(|v| v.is_finite());
         if !finite {
-            return Err("the camera's spans are not finite".into());
+            return Err(CameraError::NotFinite);
         }
         Ok(camera)
-    }
-
-    /// The camera of `scene` at `width`×`height`.
-    pub fn for_scene(scene: &Scene, width: u32, height: u32) -> Result<Camera, String> {
-        Camera::new(&scene.camera_spec(width, height), width, height)
     }
 
     /// The same camera in look-at form (for the viewer's orbit and zoom): looking at the

@@ -18,10 +18,14 @@ use crate::render::Frame;
 pub enum Format {
     /// PPM, plain (P3) or binary (P6).
     Ppm {
+        /// Binary P6 rather than plain P3.
         binary: bool,
     },
+    /// 8-bit RGB PNG.
     Png,
+    /// 8-bit RGB BMP.
     Bmp,
+    /// 8-bit RGB JPEG, quality 95.
     Jpeg,
     /// OpenEXR, linear 32-bit float.
     Exr,
@@ -29,7 +33,7 @@ pub enum Format {
 
 impl Format {
     /// The format for a path's extension (`binary_ppm` picks P6 over P3).
-    pub fn from_path(path: &Path, binary_ppm: bool) -> Result<Format, String> {
+    pub fn from_path(path: &Path, binary_ppm: bool) -> Result<Format, UnknownFormat> {
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -40,12 +44,25 @@ impl Format {
             "bmp" => Ok(Format::Bmp),
             "jpg" | "jpeg" => Ok(Format::Jpeg),
             "exr" => Ok(Format::Exr),
-            _ => Err(format!(
-                "{}: unknown image format (use .ppm, .png, .bmp, .jpg or .exr)",
-                path.display()
-            )),
+            _ => Err(UnknownFormat(path.to_path_buf())),
         }
     }
+}
+
+/// A file name whose extension names no format `whitted` writes.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{}: unknown image format (use .ppm, .png, .bmp, .jpg or .exr)", .0.display())]
+pub struct UnknownFormat(pub PathBuf);
+
+/// Why a frame could not be encoded.
+#[derive(Debug, thiserror::Error)]
+pub enum EncodeError {
+    /// The encoder of the `image` crate failed.
+    #[error(transparent)]
+    Image(#[from] image::ImageError),
+    /// EXR holds linear values: it is encoded from a frame, not from 8-bit bytes.
+    #[error("EXR is written from linear values, not bytes")]
+    ExrFromBytes,
 }
 
 /// A linear value to 8 bits: `round(clamp(c, 0, 1)·255)`, no gamma (SPEC §2).
@@ -94,14 +111,21 @@ pub fn to_rgb32f(frame: &Frame) -> Rgb32FImage {
 }
 
 #[derive(Debug, thiserror::Error)]
+/// Why an image file could not be written (nothing was left behind).
 #[error("{path}: {message}")]
 pub struct SaveError {
+    /// The file asked for.
     pub path: String,
+    /// What went wrong.
     pub message: String,
 }
 
 /// Encodes 8-bit RGB (top row first) in `format`.
-pub fn encode_rgb8(image: &RgbImage, format: Format, out: &mut dyn Write) -> Result<(), String> {
+pub fn encode_rgb8(
+    image: &RgbImage,
+    format: Format,
+    out: &mut dyn Write,
+) -> Result<(), EncodeError> {
     let (w, h) = image.dimensions();
     let raw = image.as_raw();
     let rgb = ExtendedColorType::Rgb8;
@@ -119,9 +143,9 @@ pub fn encode_rgb8(image: &RgbImage, format: Format, out: &mut dyn Write) -> Res
         Format::Png => PngEncoder::new(out).write_image(raw, w, h, rgb),
         Format::Bmp => BmpEncoder::new(&mut &mut *out).write_image(raw, w, h, rgb),
         Format::Jpeg => JpegEncoder::new_with_quality(out, 95).write_image(raw, w, h, rgb),
-        Format::Exr => return Err("EXR is written from linear values, not bytes".into()),
+        Format::Exr => return Err(EncodeError::ExrFromBytes),
     };
-    result.map_err(|e| e.to_string())
+    Ok(result?)
 }
 
 /// The folder a file at `path` goes into (`.` for a bare file name).
@@ -229,12 +253,11 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
 }
 
 /// The frame encoded in `format`.
-pub fn encode(frame: &Frame, format: Format) -> Result<Vec<u8>, String> {
+pub fn encode(frame: &Frame, format: Format) -> Result<Vec<u8>, EncodeError> {
     let mut out = Vec::new();
     match format {
         Format::Exr => DynamicImage::ImageRgb32F(to_rgb32f(frame))
-            .write_to(&mut Cursor::new(&mut out), ImageFormat::OpenExr)
-            .map_err(|e| e.to_string())?,
+            .write_to(&mut Cursor::new(&mut out), ImageFormat::OpenExr)?,
         _ => encode_rgb8(&to_rgb8(frame), format, &mut out)?,
     }
     Ok(out)
@@ -242,9 +265,9 @@ pub fn encode(frame: &Frame, format: Format) -> Result<Vec<u8>, String> {
 
 /// Saves the frame to `path` in `format`, atomically.
 pub fn save(frame: &Frame, path: &Path, format: Format) -> Result<(), SaveError> {
-    let bytes = encode(frame, format).map_err(|message| SaveError {
+    let bytes = encode(frame, format).map_err(|e| SaveError {
         path: path.display().to_string(),
-        message: format!("cannot encode: {message}"),
+        message: format!("cannot encode: {e}"),
     })?;
     write_atomically(path, &bytes)
 }

@@ -12,9 +12,9 @@ use clap::{Args, Parser, Subcommand};
 
 use whitted::bench::{self, BenchOptions};
 use whitted::image_io::{self, Format};
-use whitted::quality::Preset;
-use whitted::render::{self, Region, RenderControl, RenderOptions, Renderer};
+use whitted::render::{self, RenderControl};
 use whitted::scene::{self, Scene};
+use whitted::settings::{Overrides, Precision, Preset, Region};
 
 #[derive(Parser)]
 #[command(
@@ -118,6 +118,23 @@ struct RenderArgs {
     quiet: bool,
 }
 
+impl RenderArgs {
+    /// The options that override the scene's settings.
+    fn overrides(&self) -> Overrides {
+        Overrides {
+            quality: self.quality,
+            width: self.width,
+            height: self.height,
+            spp: self.spp,
+            max_depth: self.depth,
+            seed: self.seed,
+            precision: self.reference.then_some(Precision::Reference),
+            region: self.region,
+            threads: self.threads.map(|t| t as usize),
+        }
+    }
+}
+
 #[derive(Args)]
 struct BenchArgs {
     /// Folder for the outputs (and a cache of the slow reference images).
@@ -175,7 +192,7 @@ fn parse_region(text: &str) -> Result<Region, String> {
 /// An output path whose extension names a format we write (else a usage error).
 fn parse_output(text: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(text);
-    Format::from_path(&path, false)?;
+    Format::from_path(&path, false).map_err(|e| e.to_string())?;
     Ok(path)
 }
 
@@ -258,10 +275,11 @@ fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
 fn view(path: Option<&Path>, quality: Option<Preset>) -> anyhow::Result<()> {
     let mut scene = load_scene(path)?;
     if let Some(preset) = quality {
-        // As if the scene file named it: the viewer's RenderOptions::for_scene applies it.
-        scene.image.quality = Some(preset);
-        scene.image.spp = preset.quality().spp;
-        scene.image.max_depth = preset.quality().max_depth;
+        // As if the scene file named it: the viewer's Settings::for_scene applies it.
+        scene.image = scene.image.then(&Overrides {
+            quality: Some(preset),
+            ..Overrides::default()
+        });
     }
     whitted::viewer::run(scene)
 }
@@ -287,7 +305,7 @@ fn time_command(
     let scene = load_scene(path)?;
     let name = path.map_or("hw3".to_string(), |p| p.display().to_string());
     if let Some(views) = orbit {
-        let size = (scene.image.width, scene.image.height);
+        let size = (scene.settings().width, scene.settings().height);
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.map_or(0, |t| t as usize))
             .build()
@@ -298,7 +316,7 @@ fn time_command(
         println!("{line}");
         return Ok(());
     }
-    let mut opts = RenderOptions::for_scene(&scene);
+    let mut opts = scene.settings();
     opts.threads = threads.map(|t| t as usize);
     let timing = whitted::speed::time_render(&scene, &opts, runs)?;
     println!("{}", timing.result_line(&name, &opts, scene.spheres.len()));
@@ -314,28 +332,14 @@ fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     let mut targets = Vec::new();
     for path in outputs {
         // clap's parser has vetted every extension.
-        let format = Format::from_path(&path, args.ppm_binary).map_err(|m| anyhow!(m))?;
+        let format = Format::from_path(&path, args.ppm_binary)?;
         // A folder we cannot write into fails now, not after a long render.
         image_io::check_writable(&path)?;
         targets.push((path, format));
     }
 
     let scene = load_scene(args.scene.as_deref())?;
-    let mut opts = RenderOptions::for_scene(&scene);
-    if let Some(preset) = args.quality {
-        preset.quality().apply(&mut opts);
-    }
-    let image = &mut opts.image;
-    image.width = args.width.unwrap_or(image.width);
-    image.height = args.height.unwrap_or(image.height);
-    image.spp = args.spp.unwrap_or(image.spp);
-    image.max_depth = args.depth.unwrap_or(image.max_depth);
-    image.seed = args.seed.unwrap_or(image.seed);
-    opts.threads = args.threads.map(|t| t as usize);
-    opts.region = args.region;
-    if args.reference {
-        opts.renderer = Renderer::Reference;
-    }
+    let opts = scene.settings().with(&args.overrides());
     opts.check()?;
 
     let control = Arc::new(RenderControl::default());
@@ -346,7 +350,7 @@ fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     }
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let area = opts.area();
-    let total = u64::from(area.width) * u64::from(area.height) * u64::from(opts.image.spp);
+    let total = u64::from(area.width) * u64::from(area.height) * u64::from(opts.quality.spp);
     let progress = show_progress.then(|| spawn_progress(Arc::clone(&control), total));
 
     let result = render::render(&scene, &opts, &control);
@@ -377,8 +381,8 @@ fn render_command(args: RenderArgs) -> anyhow::Result<()> {
             scene.name,
             area.width,
             area.height,
-            opts.image.spp,
-            opts.image.max_depth,
+            opts.quality.spp,
+            opts.quality.max_depth,
             stats.seconds,
             stats.rays.total(),
             stats.mrays_per_second()

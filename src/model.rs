@@ -18,11 +18,17 @@ pub trait Real:
     + Div<Output = Self>
     + Neg<Output = Self>
 {
+    /// 0.
     const ZERO: Self;
+    /// 1.
     const ONE: Self;
+    /// ½.
     const HALF: Self;
+    /// 2.
     const TWO: Self;
+    /// The square root.
     fn sqrt(self) -> Self;
+    /// The nearest value to `x`.
     fn from_f64(x: f64) -> Self;
 }
 
@@ -58,10 +64,15 @@ pub trait Vector:
     + Mul<Self::R, Output = Self>
     + Div<Self::R, Output = Self>
 {
+    /// The type of a component.
     type R: Real;
+    /// The dot product.
     fn dot(self, other: Self) -> Self::R;
+    /// The y component.
     fn y(self) -> Self::R;
+    /// All three components `x`.
     fn splat(x: Self::R) -> Self;
+    /// The nearest vector to `v`.
     fn from_dvec3(v: DVec3) -> Self;
     /// One division and three products (three divisions would each wait on the square
     /// root and on the divider).
@@ -154,8 +165,11 @@ pub fn combine<V: Vector>(w_r: V::R, w_t: V::R, local: V, reflected: V, transmit
 /// Which branches of step 7 carry weight: the others are not traced at all.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Branches {
+    /// The local term (diffuse and shadows): `(1 − w_t)(1 − w_r) ≠ 0`.
     pub local: bool,
+    /// The reflected ray: `w_r ≠ 0`.
     pub reflect: bool,
+    /// The transmitted ray: `w_t ≠ 0`.
     pub transmit: bool,
 }
 
@@ -165,6 +179,7 @@ impl Branches {
         self.local && !self.reflect && !self.transmit
     }
 
+    /// The branches of a sphere with reflect weight `w_r` and transmit weight `w_t`.
     pub fn of(w_r: f64, w_t: f64) -> Self {
         Branches {
             local: (1.0 - w_t) * (1.0 - w_r) != 0.0,
@@ -187,11 +202,14 @@ pub fn primary_direction<V: Vector>(corner: V, h: V, v: V, s: V::R, t: V::R) -> 
 /// exactly is what lets the tracers spawn rays with no epsilon on their own sphere.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Side {
+    /// Away from the sphere, on the side its outward normal points to.
     Outward,
+    /// Into the sphere.
     Inward,
 }
 
 impl Side {
+    /// `Inward` for a ray that goes inside, else `Outward`.
     pub fn inside(inside: bool) -> Side {
         if inside {
             Side::Inward

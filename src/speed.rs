@@ -2,8 +2,9 @@
 //! one run compares all: median render time (acceleration build excluded, reported
 //! apart, as the Embree peer does), rays and Mrays/s.
 
-use crate::render::{render, RenderControl, RenderError, RenderOptions};
+use crate::render::{render, RenderControl, RenderError};
 use crate::scene::Scene;
+use crate::settings::Settings;
 
 /// Medians over several runs of one render.
 #[derive(Clone, Debug)]
@@ -32,14 +33,14 @@ impl Timing {
     }
 
     /// One line in the form of the peers' `RESULT` lines.
-    pub fn result_line(&self, scene: &str, opts: &RenderOptions, spheres: usize) -> String {
+    pub fn result_line(&self, scene: &str, opts: &Settings, spheres: usize) -> String {
         format!(
             "RESULT peer=whitted scene={scene} threads={} size={}x{} spheres={spheres} depth={} \
              render_s={:.4} best_s={:.4} build_s={:.4} runs={} rays={} primary={} shadow={} secondary={} mrays_s={:.3}",
             opts.threads.unwrap_or_else(rayon::current_num_threads),
-            opts.image.width,
-            opts.image.height,
-            opts.image.max_depth,
+            opts.width,
+            opts.height,
+            opts.quality.max_depth,
             self.render_seconds,
             self.best_render_seconds(),
             self.build_seconds,
@@ -64,11 +65,7 @@ fn median(values: &mut [f64]) -> f64 {
 }
 
 /// Renders `runs` times (after one warm-up) and takes medians.
-pub fn time_render(
-    scene: &Scene,
-    opts: &RenderOptions,
-    runs: usize,
-) -> Result<Timing, RenderError> {
+pub fn time_render(scene: &Scene, opts: &Settings, runs: usize) -> Result<Timing, RenderError> {
     let control = RenderControl::default();
     render(scene, opts, &control)?; // warm-up: caches, thread pool, page faults
     let mut trace = Vec::with_capacity(runs);
@@ -153,7 +150,7 @@ pub fn time_orbit(
     size: (u32, u32),
     views: usize,
     preview: bool,
-) -> Result<OrbitTiming, RenderError> {
+) -> anyhow::Result<OrbitTiming> {
     use crate::viewer::controls::{Action, CameraControl};
     use crate::viewer::schedule::{measured_speed, preview_factor};
     use crate::viewer::worker::{self, Buffers, Job, Report, TracerCache};
@@ -161,7 +158,7 @@ pub fn time_orbit(
     use std::time::Instant;
 
     let mut scene = scene.clone();
-    scene.image.spp = 1;
+    scene.image.spp = Some(1);
     let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
     let mut camera = CameraControl::new(&scene);
     let mut speed = f64::NAN;
@@ -199,7 +196,7 @@ pub fn time_orbit(
         for report in reports.into_inner() {
             match report {
                 Report::Frame(s) => shown.push(s),
-                Report::Failed { message, .. } => return Err(RenderError::Invalid(message)),
+                Report::Failed { message, .. } => anyhow::bail!(message),
             }
         }
         for s in &shown {

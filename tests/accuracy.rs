@@ -4,8 +4,9 @@
 //! the other side of an edge than the `f64` one).
 
 use whitted::image_io::to_rgb8;
-use whitted::render::{self, RenderControl, RenderOptions, Renderer};
+use whitted::render::{self, RenderControl};
 use whitted::scene::{hw3_scene, HW3_DEFAULT_SEED};
+use whitted::settings::Precision;
 
 /// Pixels that may differ by more than 8 levels, if each sits on a silhouette.
 const HANDFUL: usize = 5;
@@ -13,12 +14,12 @@ const HANDFUL: usize = 5;
 #[test]
 fn fast_matches_reference_on_hw3_640x360() {
     let scene = hw3_scene(HW3_DEFAULT_SEED);
-    let mut opts = RenderOptions::for_scene(&scene);
-    opts.image.width = 640;
-    opts.image.height = 360;
+    let mut opts = scene.settings();
+    opts.width = 640;
+    opts.height = 360;
     let control = RenderControl::default();
     let (fast, _) = render::render(&scene, &opts, &control).expect("fast render");
-    opts.renderer = Renderer::Reference;
+    opts.quality.precision = Precision::Reference;
     let (reference, _) = render::render(&scene, &opts, &control).expect("reference render");
     let (fast, reference) = (to_rgb8(&fast), to_rgb8(&reference));
     let (w, h) = reference.dimensions();

@@ -1,4 +1,5 @@
 //! The trade-off study on its tiny grid: it runs, and its outputs are complete.
+#![cfg(feature = "cli")]
 
 use glam::Vec3;
 
@@ -146,7 +147,7 @@ fn size_option_parses_and_rejects_clearly() {
 
 /// A row of a made-up scene "s" with the given setting, time and RMSE.
 fn row(spp: u32, threshold: Option<f32>, depth: u32, seconds: f64, rmse: f64) -> bench::Row {
-    use whitted::quality::{Adaptive, Quality};
+    use whitted::settings::{Adaptive, Quality};
     bench::Row {
         scene: "s".into(),
         setting: bench::Setting {

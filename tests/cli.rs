@@ -1,6 +1,7 @@
 //! The command line's contract (SPEC §5): exit status 0 on success, 2 for a usage
 //! error, 1 for anything else, with one clear line on stderr that says where (the
 //! file's line and column, or the field); and a failed write leaves no file behind.
+#![cfg(all(feature = "cli", feature = "viewer"))]
 
 use std::path::Path;
 use std::process::{Command, Output};

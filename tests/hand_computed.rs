@@ -5,7 +5,8 @@
 
 use glam::{DVec3, Vec3};
 use whitted::model;
-use whitted::render::{self, Frame, RenderControl, RenderOptions, Renderer};
+use whitted::render::{self, Frame, RenderControl};
+use whitted::settings::Precision;
 use whitted::Scene;
 
 // ---------------------------------------------------------------------------------
@@ -192,10 +193,10 @@ vertical = [0, 2, 0]
 /// Renders the scene with both renderers; returns (fast, reference).
 fn render_both(toml: &str) -> (Frame, Frame) {
     let scene = Scene::from_toml_str(toml, "test.toml").expect("a valid test scene");
-    let mut opts = RenderOptions::for_scene(&scene);
+    let mut opts = scene.settings();
     let control = RenderControl::default();
     let (fast, _) = render::render(&scene, &opts, &control).expect("fast render");
-    opts.renderer = Renderer::Reference;
+    opts.quality.precision = Precision::Reference;
     let (reference, _) = render::render(&scene, &opts, &control).expect("reference render");
     (fast, reference)
 }

@@ -5,20 +5,27 @@
 use glam::{DVec3, Vec3};
 use proptest::prelude::*;
 
-use whitted::quality::{Adaptive, Preset, Quality};
 use whitted::render::{
-    accumulate, first_pass_samples, make_tracer, render, render_bounded, resolve, Region,
-    RenderControl, RenderOptions, Renderer,
+    accumulate, first_pass_samples, make_tracer, render, render_bounded, resolve, RenderControl,
 };
 use whitted::sampling::sample_offset;
 use whitted::scene::{hw3_scene, Light, Scene, Sphere};
+use whitted::settings::{Adaptive, Overrides, Precision, Preset, Quality, Region, Settings};
 
-fn hw3_opts(width: u32, height: u32, spp: u32) -> (Scene, RenderOptions) {
+/// A layer of settings that names only a preset.
+fn preset(p: Preset) -> Overrides {
+    Overrides {
+        quality: Some(p),
+        ..Overrides::default()
+    }
+}
+
+fn hw3_opts(width: u32, height: u32, spp: u32) -> (Scene, Settings) {
     let scene = hw3_scene(2020);
-    let mut opts = RenderOptions::for_scene(&scene);
-    opts.image.width = width;
-    opts.image.height = height;
-    opts.image.spp = spp;
+    let mut opts = scene.settings();
+    opts.width = width;
+    opts.height = height;
+    opts.quality.spp = spp;
     (scene, opts)
 }
 
@@ -77,14 +84,14 @@ proptest! {
         depth in 1u32..7,
         spp in 1u32..3,
     ) {
-        let mut opts = RenderOptions::for_scene(&scene);
-        opts.image.width = 12;
-        opts.image.height = 8;
-        opts.image.max_depth = depth;
-        opts.image.spp = spp;
+        let mut opts = scene.settings();
+        opts.width = 12;
+        opts.height = 8;
+        opts.quality.max_depth = depth;
+        opts.quality.spp = spp;
         let exact = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
         prop_assert!(exact.cutoff_bound.iter().all(|&b| b == 0.0));
-        opts.cutoff = eps;
+        opts.quality.cutoff = eps;
         let cut = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
         for ((a, b), bound) in cut.frame.pixels.iter().zip(&exact.frame.pixels).zip(&cut.cutoff_bound) {
             let err = (*a - *b).abs().max_element();
@@ -98,7 +105,7 @@ proptest! {
 fn cutoff_skips_work_and_reports_a_nonzero_bound_on_hw3() {
     let (scene, mut opts) = hw3_opts(64, 36, 1);
     let exact = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
-    opts.cutoff = 0.2;
+    opts.quality.cutoff = 0.2;
     let cut = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
     assert!(cut.stats.rays.total() < exact.stats.rays.total());
     let max_bound = cut.cutoff_bound.iter().fold(0.0f32, |m, &b| m.max(b));
@@ -119,7 +126,7 @@ fn adaptive_with_threshold_zero_is_full_anti_aliasing_bit_for_bit() {
         accumulate(tracer.as_ref(), &opts, 2..spp, &mut sums, &control).unwrap();
         assert_eq!(resolve(&sums, spp, 48, 27), full, "accumulate, spp {spp}");
 
-        opts.adaptive = Some(Adaptive::with_threshold(0.0));
+        opts.quality.adaptive = Some(Adaptive::with_threshold(0.0));
         let adaptive = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
         assert_eq!(adaptive.refined, 48 * 27);
         assert_eq!(adaptive.frame, full, "spp {spp}");
@@ -129,7 +136,7 @@ fn adaptive_with_threshold_zero_is_full_anti_aliasing_bit_for_bit() {
 #[test]
 fn adaptive_region_is_the_crop_of_the_whole_image() {
     let (scene, mut opts) = hw3_opts(64, 36, 16);
-    opts.adaptive = Some(Adaptive::with_threshold(0.05));
+    opts.quality.adaptive = Some(Adaptive::with_threshold(0.05));
     let (whole, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
     for region in [
         Region {
@@ -178,7 +185,7 @@ fn adaptive_region_is_the_crop_of_the_whole_image() {
 fn adaptive_refines_edges_not_flat_sky_and_stays_close_to_full_aa() {
     let (scene, mut opts) = hw3_opts(96, 54, 16);
     let (full, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
-    opts.adaptive = Some(Adaptive::with_threshold(0.03));
+    opts.quality.adaptive = Some(Adaptive::with_threshold(0.03));
     let a = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
     let n = 96 * 54;
     assert!(
@@ -233,17 +240,17 @@ fn first_pass_samples_spread_over_the_pixel() {
 fn every_preset_renders_and_better_presets_err_less() {
     let (scene, base) = hw3_opts(32, 18, 1);
     let reference = {
-        let opts = base.clone().with_quality(&Preset::Reference.quality());
+        let opts = base.clone().with(&preset(Preset::Reference));
         render(&scene, &opts, &RenderControl::default()).unwrap().0
     };
     let mut errors = Vec::new();
-    for preset in Preset::ALL {
-        let q = preset.quality();
-        let opts = base.clone().with_quality(&q);
-        assert_eq!(Quality::of(&opts), q);
-        let (frame, stats) = render(&scene, &opts, &RenderControl::default())
-            .unwrap_or_else(|e| panic!("{preset}: {e}"));
-        assert!(frame.pixels.iter().all(|p| p.is_finite()), "{preset}");
+    for p in Preset::ALL {
+        let q = p.quality();
+        let opts = base.clone().with(&preset(p));
+        assert_eq!(opts.quality, q);
+        let (frame, stats) =
+            render(&scene, &opts, &RenderControl::default()).unwrap_or_else(|e| panic!("{p}: {e}"));
+        assert!(frame.pixels.iter().all(|p| p.is_finite()), "{p}");
         assert!(stats.rays.total() > 0);
         let sq: f32 = frame
             .pixels
@@ -254,7 +261,7 @@ fn every_preset_renders_and_better_presets_err_less() {
             })
             .sum();
         errors.push(sq);
-        assert_eq!(preset.name().parse::<Preset>(), Ok(preset));
+        assert_eq!(p.name().parse::<Preset>(), Ok(p));
     }
     assert_eq!(errors[3], 0.0, "the reference preset is the reference");
     assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
@@ -262,30 +269,30 @@ fn every_preset_renders_and_better_presets_err_less() {
 
 #[test]
 fn unknown_preset_and_bad_knobs_are_clear_errors() {
-    let e = "fast".parse::<Preset>().unwrap_err();
+    let e = "fast".parse::<Preset>().unwrap_err().to_string();
     assert!(
         e.contains("fast") && e.contains("draft, default, high or reference"),
         "{e}"
     );
     let (scene, mut opts) = hw3_opts(8, 8, 1);
-    opts.cutoff = f32::NAN;
+    opts.quality.cutoff = f32::NAN;
     assert!(render(&scene, &opts, &RenderControl::default()).is_err());
-    opts.cutoff = 0.0;
-    opts.adaptive = Some(Adaptive {
+    opts.quality.cutoff = 0.0;
+    opts.quality.adaptive = Some(Adaptive {
         first: 0,
         threshold: 0.1,
     });
     assert!(render(&scene, &opts, &RenderControl::default()).is_err());
-    opts.adaptive = Some(Adaptive::with_threshold(-1.0));
+    opts.quality.adaptive = Some(Adaptive::with_threshold(-1.0));
     assert!(render(&scene, &opts, &RenderControl::default()).is_err());
 }
 
 #[test]
 fn reference_precision_ignores_the_cutoff() {
     let (scene, mut opts) = hw3_opts(16, 9, 1);
-    opts.renderer = Renderer::Reference;
+    opts.quality.precision = Precision::Reference;
     let (exact, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
-    opts.cutoff = 0.3;
+    opts.quality.cutoff = 0.3;
     let (cut, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
     assert_eq!(exact, cut);
 }
@@ -297,11 +304,8 @@ fn scene_file_quality_key_sets_the_preset_and_explicit_keys_win() {
     let scene = Scene::from_toml_str(text, "q.toml").unwrap();
     let q = Preset::Default.quality();
     assert_eq!(scene.image.quality, Some(Preset::Default));
-    assert_eq!(
-        (scene.image.spp, scene.image.max_depth),
-        (q.spp, q.max_depth)
-    );
-    assert_eq!(Quality::of(&RenderOptions::for_scene(&scene)), q);
+    assert_eq!((scene.image.spp, scene.image.max_depth), (None, None));
+    assert_eq!(scene.settings().quality, q);
     // The written scene keeps the key and loads back the same.
     let again = Scene::from_toml_str(&whitted::scene::to_toml(&scene), "w.toml").unwrap();
     assert_eq!(again.image, scene.image);
@@ -309,10 +313,10 @@ fn scene_file_quality_key_sets_the_preset_and_explicit_keys_win() {
     let text =
         "[image]\nquality = \"high\"\nspp = 4\n\n[[sphere]]\ncenter = [0, 0, -2]\nradius = 0.5\n";
     let scene = Scene::from_toml_str(text, "q.toml").unwrap();
-    let opts = RenderOptions::for_scene(&scene);
-    assert_eq!(opts.image.spp, 4);
-    assert_eq!(opts.image.max_depth, Preset::High.quality().max_depth);
-    assert_eq!(opts.adaptive, Preset::High.quality().adaptive);
+    let opts = scene.settings();
+    assert_eq!(opts.quality.spp, 4);
+    assert_eq!(opts.quality.max_depth, Preset::High.quality().max_depth);
+    assert_eq!(opts.quality.adaptive, Preset::High.quality().adaptive);
 
     let text = "[image]\nquality = \"ultra\"\n";
     let e = Scene::from_toml_str(text, "bad.toml")
@@ -329,7 +333,7 @@ fn scene_file_quality_key_sets_the_preset_and_explicit_keys_win() {
 fn scenes_without_the_key_render_as_before() {
     let scene = hw3_scene(2020);
     assert_eq!(scene.image.quality, None);
-    let opts = RenderOptions::for_scene(&scene);
-    assert_eq!(Quality::of(&opts), Quality::default());
+    let opts = scene.settings();
+    assert_eq!(opts.quality, Quality::default());
     assert_eq!(Quality::default(), Preset::Draft.quality());
 }

@@ -1,4 +1,5 @@
 //! `whitted render --quality` and `whitted bench` from the command line.
+#![cfg(all(feature = "cli", feature = "viewer"))]
 
 use std::process::Command;
 

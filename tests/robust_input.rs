@@ -2,6 +2,7 @@
 //! text, TOML-like token soup, and the hw3 and stress scene files mutated), the limits
 //! checked before any allocation, and the command line writing to a full disk, a
 //! read-only folder or `/dev/full`, or interrupted by SIGINT: exit 1, no partial file.
+#![cfg(all(feature = "cli", feature = "viewer"))]
 
 mod robust_support;
 
@@ -13,8 +14,10 @@ use std::time::{Duration, Instant};
 use proptest::prelude::*;
 use robust_support::cases::runner;
 use robust_support::*;
-use whitted::render::Renderer;
-use whitted::scene::{self, limits, ImageSettings, Scene};
+use whitted::limits;
+use whitted::scene::{self, Scene};
+use whitted::settings::Precision;
+use whitted::settings::Settings;
 
 const PATH: &str = "fuzz.toml";
 
@@ -39,8 +42,8 @@ fn check_input(text: &str, stats: &RefCell<Fuzzed>) -> Result<(), TestCaseError>
             prop_assert_eq!(a, b, "the two parsing paths disagree");
             s.accepted += 1;
             let mut scene = a.clone();
-            scene.image.max_depth = scene.image.max_depth.min(4);
-            for renderer in [Renderer::Fast, Renderer::Reference] {
+            scene.image.max_depth = Some(scene.settings().quality.max_depth.min(4));
+            for renderer in [Precision::Fast, Precision::Reference] {
                 let img = render_with(&scene, 4, 3, renderer);
                 // Non-finite samples are zeroed before they reach a file: count only.
                 prop_assert_eq!(img.rgb.len(), 36);
@@ -312,29 +315,24 @@ fn image_limits_are_refused_with_a_located_message() {
         println!("{text:?} -> {e}");
     }
     // The settings check itself, at the edge.
-    let ok = ImageSettings {
+    let ok = Settings {
         width: 16384,
         height: 16384,
         ..Default::default()
     };
     assert!(ok.check().is_ok());
-    let over = ImageSettings {
+    let over = Settings {
         height: 16385,
-        ..ok
+        ..ok.clone()
     };
-    assert!(over.check().unwrap_err().contains("pixels"));
-    assert!(ImageSettings {
-        max_depth: 65,
-        ..ok
-    }
-    .check()
-    .is_err());
-    assert!(ImageSettings {
-        max_depth: 64,
-        ..ok
-    }
-    .check()
-    .is_ok());
+    assert!(over.check().unwrap_err().to_string().contains("pixels"));
+    let depth = |max_depth| {
+        let mut s = ok.clone();
+        s.quality.max_depth = max_depth;
+        s.check()
+    };
+    assert!(depth(65).is_err());
+    assert!(depth(64).is_ok());
 }
 
 #[test]

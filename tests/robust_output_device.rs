@@ -1,6 +1,7 @@
 //! Output to a device: a render written to a full device fails with exit 1 and leaves
 //! the device alone (`image_io::write_atomically` writes into a target that exists and
 //! is not a regular file instead of renaming a temporary file over it).
+#![cfg(all(feature = "cli", feature = "viewer"))]
 
 /// A render written to a device node that behaves like `/dev/full` (char 1,7,
 /// made with mknod under the name `out.png` in a temporary folder, so that the real

@@ -13,9 +13,10 @@ use robust_support::cases::{self, ior, runner, sin_between};
 use robust_support::*;
 use whitted::accel::Spheres;
 use whitted::camera::Camera;
+use whitted::camera::CameraSpec;
 use whitted::model::{self, Side};
-use whitted::render::Renderer;
-use whitted::scene::{CameraSpec, Light, Scene, Sphere};
+use whitted::scene::{Light, Scene, Sphere};
+use whitted::settings::Precision;
 use whitted::trace::fast::FastTracer;
 use whitted::trace::reference::ReferenceTracer;
 use whitted::trace::{RayCounts, SampleTracer};
@@ -207,7 +208,7 @@ fn mirrors() -> (Scene, Camera) {
         lights: vec![Light::default()],
         spheres: vec![mirror(-r - 1.0), mirror(r + 1.0)],
     };
-    let camera = Camera::for_scene(&scene, 16, 9).unwrap();
+    let camera = scene.camera(16, 9).unwrap();
     (scene, camera)
 }
 
@@ -245,8 +246,8 @@ fn facing_mirrors_at_depth_64_bounce_to_the_limit() {
     }
     // And the whole stress scene at depth 64 through the renderer's threads.
     let scene = Scene::load(&stress_dir().join("facing-mirrors.toml")).unwrap();
-    assert_eq!(scene.image.max_depth, 64);
-    for renderer in [Renderer::Fast, Renderer::Reference] {
+    assert_eq!(scene.image.max_depth, Some(64));
+    for renderer in [Precision::Fast, Precision::Reference] {
         let img = render_with(&scene, 160, 90, renderer);
         assert_eq!(img.non_finite, 0);
     }

@@ -7,8 +7,8 @@
 mod robust_support;
 
 use robust_support::*;
-use whitted::render::Renderer;
 use whitted::scene::Scene;
+use whitted::settings::Precision;
 
 const W: u32 = 320;
 const H: u32 = 180;
@@ -76,7 +76,7 @@ fn fast_matches_reference_on_the_stress_scenes() {
 fn transformed_hw3_renders_like_hw3() {
     println!("\n{TRANSFORM_TABLE_HEADER}");
     let all = ["scale 1e-3", "scale 1e3", "translate (1e4,1e4,1e4)"];
-    let mut failures = check_transforms(Renderer::Fast, &all, W, H);
-    failures.extend(check_transforms(Renderer::Reference, &all, W, H));
+    let mut failures = check_transforms(Precision::Fast, &all, W, H);
+    failures.extend(check_transforms(Precision::Reference, &all, W, H));
     assert!(failures.is_empty(), "{failures:?}");
 }

@@ -8,11 +8,9 @@ use common::whitted;
 use std::path::Path;
 
 use glam::DVec3;
-use whitted::camera::Camera;
-use whitted::scene::{
-    assignment_vfov_degrees, hw3_scene, to_toml, CameraSpec, ImageSettings, Light, Sky, Sphere,
-    HW3_DEFAULT_SEED,
-};
+use whitted::camera::{assignment_vfov_degrees, CameraSpec};
+use whitted::scene::{hw3_scene, to_toml, Light, Sky, Sphere, HW3_DEFAULT_SEED};
+use whitted::settings::Overrides;
 use whitted::Scene;
 
 const ASSET: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/hw3.toml");
@@ -124,7 +122,8 @@ fn writing_and_loading_round_trips() {
     );
     scene.name = "scene".into();
     // The file's own spp and depth win over the preset's.
-    assert_eq!((scene.image.spp, scene.image.max_depth), (9, 3));
+    let s = scene.settings();
+    assert_eq!((s.quality.spp, s.quality.max_depth), (9, 3));
     assert!(scene.image.quality.is_some());
     assert_eq!(parse(&to_toml(&scene)), scene);
     let framed = Scene {
@@ -138,16 +137,17 @@ fn writing_and_loading_round_trips() {
 fn missing_tables_and_keys_take_the_defaults() {
     let scene = parse("[[sphere]]\ncenter = [0.0, 0.0, -1.0]\nradius = 0.5\n");
     assert_eq!(scene.camera, None, "no camera: the assignment's");
+    assert_eq!(scene.image, Overrides::default(), "no [image]: nothing set");
+    let s = scene.settings();
     assert_eq!(
-        scene.image,
-        ImageSettings {
-            width: 1280,
-            height: 720,
-            max_depth: 5,
-            spp: 1,
-            seed: 0,
-            quality: None
-        }
+        (
+            s.width,
+            s.height,
+            s.quality.max_depth,
+            s.quality.spp,
+            s.seed
+        ),
+        (1280, 720, 5, 1, 0)
     );
     assert_eq!(
         scene.sky,
@@ -176,10 +176,8 @@ fn missing_tables_and_keys_take_the_defaults() {
     );
     // Partial tables keep the defaults of the keys they leave out.
     let scene = parse("[image]\nspp = 4\n[sky]\nup = [0, 0, 1]\n[[light]]\nposition = [1, 2, 3]\n");
-    assert_eq!(
-        (scene.image.spp, scene.image.width, scene.image.max_depth),
-        (4, 1280, 5)
-    );
+    let s = scene.settings();
+    assert_eq!((s.quality.spp, s.width, s.quality.max_depth), (4, 1280, 5));
     assert_eq!((scene.sky.down, scene.sky.up), (DVec3::ONE, DVec3::Z));
     assert_eq!(scene.lights[0].intensity, DVec3::ONE);
     // An empty file is an empty scene under the default light.
@@ -233,7 +231,7 @@ fn both_camera_forms() {
         vertical: DVec3::new(0.0, 2.0, 0.0),
     };
     assert_eq!(scene.camera, Some(spec));
-    let cam = Camera::for_scene(&scene, 100, 100).unwrap();
+    let cam = scene.camera(100, 100).unwrap();
     assert_eq!(
         (cam.origin, cam.lower_left, cam.horizontal, cam.vertical),
         (
@@ -258,7 +256,7 @@ fn both_camera_forms() {
             vfov: 90.0
         })
     );
-    let cam = Camera::for_scene(&scene, 200, 100).unwrap();
+    let cam = scene.camera(200, 100).unwrap();
     assert_close(cam.origin, DVec3::ZERO);
     assert_close(cam.lower_left, DVec3::new(-2.0, -1.0, -1.0));
     assert_close(cam.horizontal, DVec3::new(4.0, 0.0, 0.0));
@@ -269,7 +267,7 @@ fn both_camera_forms() {
     // LL = (1,2,3) − (0,0,1) − (0,1,0) + (1,0,0) = (2,1,2), H = (0,0,2), V = (0,2,0).
     let scene =
         parse("[camera]\nlook_from = [1, 2, 3]\nlook_at = [5, 2, 3]\nup = [0, 1, 0]\nvfov = 90\n");
-    let cam = Camera::for_scene(&scene, 100, 100).unwrap();
+    let cam = scene.camera(100, 100).unwrap();
     assert_close(cam.origin, DVec3::new(1.0, 2.0, 3.0));
     assert_close(cam.horizontal, DVec3::new(0.0, 0.0, 2.0));
     assert_close(cam.vertical, DVec3::new(0.0, 2.0, 0.0));
@@ -297,7 +295,7 @@ fn both_camera_forms() {
 fn no_camera_means_the_assignments_view_at_any_aspect() {
     let scene = parse("");
     // 16:9: the assignment's exact frame.
-    let cam = Camera::for_scene(&scene, 1280, 720).unwrap();
+    let cam = scene.camera(1280, 720).unwrap();
     assert_eq!(cam.lower_left, DVec3::new(-4.0, -2.25, -1.0));
     assert_eq!(
         (cam.horizontal, cam.vertical),
@@ -305,7 +303,7 @@ fn no_camera_means_the_assignments_view_at_any_aspect() {
     );
     // 4:3: the same vertical view (vfov = 2·atan 2.25), the horizontal span follows.
     assert!((assignment_vfov_degrees() - 132.07502205).abs() < 1e-8);
-    let cam = Camera::for_scene(&scene, 800, 600).unwrap();
+    let cam = scene.camera(800, 600).unwrap();
     assert_close(cam.vertical, DVec3::new(0.0, 4.5, 0.0));
     assert_close(cam.horizontal, DVec3::new(6.0, 0.0, 0.0));
     assert_close(cam.lower_left, DVec3::new(-3.0, -2.25, -1.0));

@@ -5,6 +5,7 @@
 //!
 //! The tests need `Xvfb`, `xdotool` and ImageMagick's `import`; without them they say
 //! so loudly on stderr and pass (CI always has them: see `.ci/run`).
+#![cfg(all(feature = "cli", feature = "viewer"))]
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -237,9 +238,9 @@ impl Drop for Viewer {
 /// The built-in scene at 320×180 written as `small.toml` in `dir`.
 fn small_scene(dir: &Path, spp: u32) -> PathBuf {
     let mut scene = whitted::scene::hw3_scene(whitted::scene::HW3_DEFAULT_SEED);
-    scene.image.width = 320;
-    scene.image.height = 180;
-    scene.image.spp = spp;
+    scene.image.width = Some(320);
+    scene.image.height = Some(180);
+    scene.image.spp = Some(spp);
     let path = dir.join("small.toml");
     fs::write(&path, whitted::scene::to_toml(&scene)).unwrap();
     path

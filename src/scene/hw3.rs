@@ -8,8 +8,10 @@
 use glam::DVec3;
 use rand_mt::Mt;
 
-use super::{ImageSettings, Light, Scene, Sky, Sphere};
+use super::{Light, Scene, Sky, Sphere};
+use crate::settings::{Overrides, Settings};
 
+/// The seed of the built-in scene's 48 small balls.
 pub const HW3_DEFAULT_SEED: u64 = 2020;
 
 const PALETTE: [[f64; 3]; 8] = [
@@ -106,10 +108,7 @@ pub fn hw3_scene(seed: u64) -> Scene {
     Scene {
         name: "hw3".into(),
         camera: None,
-        image: ImageSettings {
-            seed: 0,
-            ..ImageSettings::default()
-        },
+        image: explicit(&Settings::default()),
         sky: Sky::default(),
         lights: vec![Light::default()],
         spheres,
@@ -145,4 +144,16 @@ pub fn hw3_toml(seed: u64) -> String {
         out.push_str(part);
     }
     out
+}
+
+/// Every value of `[image]` spelled out, as the built-in scene's file gives them.
+fn explicit(s: &Settings) -> Overrides {
+    Overrides {
+        width: Some(s.width),
+        height: Some(s.height),
+        max_depth: Some(s.quality.max_depth),
+        spp: Some(s.quality.spp),
+        seed: Some(s.seed),
+        ..Overrides::default()
+    }
 }

@@ -18,7 +18,10 @@ use rayon::prelude::*;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::{limits, CameraSpec, ImageSettings, Light, Scene, SceneError, Sky, Sphere};
+use super::{Light, Scene, SceneError, Sky, Sphere};
+use crate::camera::CameraSpec;
+use crate::limits;
+use crate::settings::{Overrides, Preset, Settings, UnknownPreset};
 
 type V3 = Spanned<[f64; 3]>;
 type Num = Spanned<f64>;
@@ -504,17 +507,14 @@ fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
         Some(c) => Some(camera(at, c)?),
     };
 
-    let mut image = ImageSettings::default();
+    let mut image = Overrides::default();
     if let Some(spanned) = &file.image {
         let img = spanned.get_ref();
-        // A quality preset first: the file's own spp and max_depth override its values.
         if let Some(q) = &img.quality {
-            let preset: crate::quality::Preset = q
+            let preset: Preset = q
                 .get_ref()
                 .parse()
-                .map_err(|m: String| at.at(q.span(), format!("image.quality: {m}")))?;
-            image.spp = preset.quality().spp;
-            image.max_depth = preset.quality().max_depth;
+                .map_err(|e: UnknownPreset| at.at(q.span(), format!("image.quality: {e}")))?;
             image.quality = Some(preset);
         }
         let dims = [
@@ -556,7 +556,7 @@ fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
                         format!("image.{key} = {n} is out of range: expected {lo} to {hi}"),
                     ));
                 }
-                *slot = n as u32;
+                *slot = Some(n as u32);
             }
         }
         if let Some(seed) = &img.seed {
@@ -567,9 +567,12 @@ fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
                     format!("image.seed = {n} must not be negative"),
                 ));
             }
-            image.seed = n as u64;
+            image.seed = Some(n as u64);
         }
-        image.check().map_err(|m| at.at(spanned.span(), m))?;
+        Settings::default()
+            .with(&image)
+            .check()
+            .map_err(|e| at.at(spanned.span(), e.to_string()))?;
     }
 
     let mut sky = Sky::default();
@@ -775,7 +778,8 @@ fn camera(at: &Locator, c: &Spanned<FileCamera>) -> Result<CameraSpec, SceneErro
             },
         }
     };
-    crate::camera::check_spec(&spec).map_err(|m| at.at(c.span(), format!("camera: {m}")))?;
+    spec.check()
+        .map_err(|e| at.at(c.span(), format!("camera: {e}")))?;
     Ok(spec)
 }
 

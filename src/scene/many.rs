@@ -5,7 +5,9 @@
 use glam::DVec3;
 
 use super::hw3::{random_material, PyRandom};
-use super::{CameraSpec, ImageSettings, Light, Scene, Sky, Sphere};
+use super::{Light, Scene, Sky, Sphere};
+use crate::camera::CameraSpec;
+use crate::settings::Overrides;
 
 /// `round(x, 6)` as Python prints it: correctly rounded to six decimals.
 fn round6(x: f64) -> f64 {
@@ -67,10 +69,10 @@ pub fn many_scene(n: usize) -> Scene {
     Scene {
         name: format!("many_{n}"),
         camera: Some(camera),
-        image: ImageSettings {
-            width,
-            height,
-            ..ImageSettings::default()
+        image: Overrides {
+            width: Some(width),
+            height: Some(height),
+            ..Overrides::default()
         },
         sky: Sky::default(),
         lights: vec![Light {

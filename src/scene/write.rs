@@ -2,7 +2,8 @@
 
 use serde::Serialize;
 
-use super::{CameraSpec, Scene};
+use super::Scene;
+use crate::camera::CameraSpec;
 
 #[derive(Serialize)]
 struct OutScene {
@@ -33,11 +34,16 @@ enum OutCamera {
 
 #[derive(Serialize)]
 struct OutImage {
-    width: u32,
-    height: u32,
-    max_depth: u32,
-    spp: u32,
-    seed: u64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    width: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    height: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    max_depth: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    spp: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    seed: Option<u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     quality: Option<&'static str>,
 }

@@ -42,6 +42,7 @@ struct Compiled {
     value_bound: f32,
 }
 
+/// The fast `f32` tracer: the scene compiled into acceleration structures for one camera.
 pub struct FastTracer {
     compiled: Arc<Compiled>,
     /// The camera-dependent part of the acceleration structures.
@@ -63,6 +64,7 @@ struct Skipped {
 }
 
 impl FastTracer {
+    /// Compiles `scene` for `camera`, tracing to depth `max_depth`.
     pub fn new(scene: &Scene, camera: &Camera, max_depth: u32) -> Self {
         let lights: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
         let (spheres, eye) = Spheres::build_for_view(&scene.spheres, &lights, camera.origin);

@@ -8,7 +8,9 @@ use crate::model::{Real, Vector};
 /// (`f = o − c`), and the sphere's outward normals there, or `None` on a miss.
 #[derive(Clone, Copy, Debug)]
 pub struct Roots<V: Vector> {
+    /// The near root `t_near`.
     pub near: V::R,
+    /// The far root `t_far`.
     pub far: V::R,
     /// `l = f + (−f·d)·d`: centre to the closest point of the line.
     pub closest: V,

@@ -12,16 +12,21 @@ use glam::Vec3;
 /// Rays cast while rendering, by kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RayCounts {
+    /// Rays from the eye.
     pub primary: u64,
+    /// Reflected and transmitted rays.
     pub secondary: u64,
+    /// Rays towards a light.
     pub shadow: u64,
 }
 
 impl RayCounts {
+    /// Rays of every kind.
     pub fn total(&self) -> u64 {
         self.primary + self.secondary + self.shadow
     }
 
+    /// Adds the counts of `other`.
     pub fn add(&mut self, other: &RayCounts) {
         self.primary += other.primary;
         self.secondary += other.secondary;

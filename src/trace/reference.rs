@@ -13,6 +13,7 @@ use crate::model::{self, Branches, Side};
 
 use crate::scene::{Scene, Sphere};
 
+/// The `f64` reference tracer: the model of SPEC §2 written for clarity, sphere by sphere.
 pub struct ReferenceTracer<'a> {
     scene: &'a Scene,
     camera: Camera,
@@ -40,12 +41,16 @@ struct Hit {
 /// Which way a ray of the ray tree was cast.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RayKind {
+    /// From the eye.
     Primary,
+    /// Reflected (step 5).
     Reflect,
+    /// Transmitted or totally internally reflected (step 6).
     Transmit,
 }
 
 impl RayKind {
+    /// The kind in lower case, for the viewer.
     pub fn name(self) -> &'static str {
         match self {
             RayKind::Primary => "primary",
@@ -58,8 +63,11 @@ impl RayKind {
 /// Where a recorded ray hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HitRecord {
+    /// The sphere hit (its index in the scene, from 0).
     pub sphere: usize,
+    /// The hit point.
     pub point: DVec3,
+    /// The outward unit normal there.
     pub normal: DVec3,
     /// The ray enters the sphere here (near root).
     pub entering: bool,
@@ -68,6 +76,7 @@ pub struct HitRecord {
 /// One shadow ray towards a light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowRecord {
+    /// The light (its index in the scene, from 0).
     pub light: usize,
     /// The occluder that set the shadow factor (the smallest one), if any.
     pub occluder: Option<usize>,
@@ -82,9 +91,13 @@ pub struct ShadowRecord {
 /// One ray of a ray tree, with what it hit, its shadow rays and its children.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RayNode {
+    /// Which way the ray was cast.
     pub kind: RayKind,
+    /// Its depth (0 for a primary ray).
     pub depth: u32,
+    /// Its origin.
     pub origin: DVec3,
+    /// Its unit direction.
     pub dir: DVec3,
     /// The weight of this ray's colour in the pixel (the product of the mixing weights
     /// of step 7 along the path).
@@ -93,7 +106,9 @@ pub struct RayNode {
     pub hit: Option<HitRecord>,
     /// The ray was not traced because `depth ≥ max_depth`: its colour is the sky's.
     pub depth_limited: bool,
+    /// The shadow rays of the hit, one a light.
     pub shadows: Vec<ShadowRecord>,
+    /// The reflected and transmitted rays of the hit.
     pub children: Vec<RayNode>,
     /// The colour `trace` returned for this ray.
     pub colour: DVec3,
@@ -104,7 +119,9 @@ pub struct RayNode {
 pub trait Recorder {
     /// A ray starts; `mix` is its weight in its parent's colour (1 for a primary ray).
     fn begin(&mut self, _kind: RayKind, _depth: u32, _origin: DVec3, _dir: DVec3, _mix: f64) {}
+    /// The ray reached the depth limit.
     fn depth_limit(&mut self) {}
+    /// The ray hit a sphere.
     fn hit(&mut self, _hit: &HitRecord) {}
     /// A shadow ray; `mix` is the weight of the local term in this ray's colour.
     fn shadow(
@@ -204,6 +221,7 @@ fn spawn_tolerance(p: DVec3) -> f64 {
 }
 
 impl<'a> ReferenceTracer<'a> {
+    /// The tracer of `scene` through `camera`, tracing to depth `max_depth`.
     pub fn new(scene: &'a Scene, camera: Camera, max_depth: u32) -> Self {
         ReferenceTracer {
             scene,

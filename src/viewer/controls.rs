@@ -8,7 +8,8 @@
 use glam::{DMat3, DVec3};
 
 use crate::camera::Camera;
-use crate::scene::{CameraSpec, Scene};
+use crate::camera::CameraSpec;
+use crate::scene::Scene;
 
 /// The smallest and largest vertical field of view the wheel reaches, in degrees.
 pub const MIN_VFOV: f64 = 1.0;
@@ -125,7 +126,7 @@ impl CameraControl {
     pub fn new(scene: &Scene) -> Self {
         CameraControl {
             scene_spec: scene.camera,
-            scene_size: (scene.image.width, scene.image.height),
+            scene_size: (scene.settings().width, scene.settings().height),
             edited: None,
         }
     }
@@ -185,7 +186,7 @@ impl CameraControl {
             Action::Right(n) => view.translate(0.0, n, 0.0),
             Action::Lift(n) => view.translate(0.0, 0.0, n),
         }
-        let valid = crate::camera::check_spec(&view.spec()).is_ok()
+        let valid = view.spec().check().is_ok()
             && [view.look_from, view.look_at].iter().all(|p| p.is_finite());
         if !valid || view == before {
             return false;
@@ -243,7 +244,7 @@ mod tests {
             .angle_between(DVec3::Y)
             .to_degrees();
         assert!((angle - POLE_MARGIN_DEG).abs() < 1e-9, "angle {angle}");
-        assert!(crate::camera::check_spec(&v.spec()).is_ok());
+        assert!(v.spec().check().is_ok());
     }
 
     #[test]
@@ -280,7 +281,7 @@ mod tests {
         assert!(c.apply(&scene, 1280, 720, Action::Zoom(1.0)));
         match c.spec(&scene, 1280, 720) {
             CameraSpec::LookAt { vfov, .. } => {
-                let expected = crate::scene::assignment_vfov_degrees() * 0.9;
+                let expected = crate::camera::assignment_vfov_degrees() * 0.9;
                 assert!((vfov - expected).abs() < 1e-9, "vfov {vfov}");
             }
             other => panic!("expected look-at form, got {other:?}"),
@@ -298,7 +299,7 @@ mod tests {
         assert_eq!(c.spec(&scene, 1280, 720), CameraSpec::assignment_frame());
         match c.spec(&scene, 640, 640) {
             CameraSpec::LookAt { vfov, .. } => {
-                let expected = crate::scene::assignment_vfov_degrees();
+                let expected = crate::camera::assignment_vfov_degrees();
                 assert!((vfov - expected).abs() < 1e-9);
             }
             other => panic!("expected look-at form, got {other:?}"),

@@ -6,7 +6,6 @@ use std::fmt::Write;
 
 use glam::{DVec3, Vec3};
 
-use crate::camera::Camera;
 use crate::image_io::to_byte;
 use crate::scene::Scene;
 use crate::trace::reference::{RayNode, ReferenceTracer};
@@ -25,8 +24,10 @@ pub fn report(
     j: u32,
     shown: Vec3,
 ) -> Result<String, String> {
-    let camera = Camera::for_scene(scene, width, height)?;
-    let tracer = ReferenceTracer::new(scene, camera, scene.image.max_depth);
+    let camera = scene
+        .camera(width, height)
+        .map_err(|e| format!("camera: {e}"))?;
+    let tracer = ReferenceTracer::new(scene, camera, scene.settings().quality.max_depth);
     let s = (f64::from(i) + 0.5) / f64::from(width);
     let t = (f64::from(j) + 0.5) / f64::from(height);
     let (colour, tree) = tracer.inspect(s, t);
@@ -140,8 +141,8 @@ mod tests {
     fn the_tree_adds_up_to_the_reference_colour() {
         let scene = hw3_scene(HW3_DEFAULT_SEED);
         let (w, h) = (64, 36);
-        let camera = Camera::for_scene(&scene, w, h).unwrap();
-        let tracer = ReferenceTracer::new(&scene, camera, scene.image.max_depth);
+        let camera = scene.camera(w, h).unwrap();
+        let tracer = ReferenceTracer::new(&scene, camera, scene.settings().quality.max_depth);
         let mut deepest = 0;
         for j in 0..h {
             for i in 0..w {

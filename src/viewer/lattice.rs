@@ -8,7 +8,8 @@
 
 use glam::Vec3;
 
-use crate::render::{self, RenderControl, RenderError, RenderOptions};
+use crate::render::{self, RenderControl, RenderError};
+use crate::settings::Settings;
 use crate::trace::{RayCounts, SampleTracer};
 
 /// One pixel of every `factor`×`factor` block of the render area, the blocks anchored
@@ -42,7 +43,7 @@ impl Lattice {
 /// computes it for that pixel.
 pub fn sample_lattice<T: SampleTracer + ?Sized>(
     tracer: &T,
-    opts: &RenderOptions,
+    opts: &Settings,
     lattice: Lattice,
     out: &mut [Vec3],
     control: &RenderControl,
@@ -53,11 +54,11 @@ pub fn sample_lattice<T: SampleTracer + ?Sized>(
     let columns: Vec<u32> = (0..bw)
         .map(|b| area.x + lattice.pick(b, area.width))
         .collect();
-    let centres = render::centres_of(opts, &columns);
+    let centres = render::film::centres_of(opts, &columns);
     // The area's bottom row, counted from the image's bottom.
-    let j0 = opts.image.height - (area.y + area.height);
+    let j0 = opts.height - (area.y + area.height);
     let progress = u64::from(bw);
-    render::for_each_band(
+    render::bands::for_each_band(
         opts,
         out,
         bw as usize,
@@ -65,7 +66,7 @@ pub fn sample_lattice<T: SampleTracer + ?Sized>(
         control,
         |b, row, counts| {
             let j = j0 + lattice.pick(b as u32, area.height);
-            render::first_samples(tracer, opts, &columns, &centres, j, row, counts);
+            render::progressive::first_samples(tracer, opts, &columns, &centres, j, row, counts);
         },
     )
 }
@@ -75,7 +76,7 @@ pub fn sample_lattice<T: SampleTracer + ?Sized>(
 /// lattice's: the other pixels are traced, the lattice's copied; then `after_row`.
 pub fn accumulate_first_around<T: SampleTracer + ?Sized>(
     tracer: &T,
-    opts: &RenderOptions,
+    opts: &Settings,
     (lattice, values): (Lattice, &[Vec3]),
     sums: &mut [Vec3],
     control: &RenderControl,
@@ -89,12 +90,12 @@ pub fn accumulate_first_around<T: SampleTracer + ?Sized>(
         "one value per block"
     );
     let all: Vec<u32> = (area.x..area.x + area.width).collect();
-    let all_centres = render::centres_of(opts, &all);
+    let all_centres = render::film::centres_of(opts, &all);
     // The columns of a lattice row that are traced, and the lattice's (with its block).
     let (rest, picked): (Vec<u32>, Vec<u32>) = all
         .iter()
         .partition(|&&i| !lattice.holds(i - area.x, area.width));
-    let rest_centres = render::centres_of(opts, &rest);
+    let rest_centres = render::film::centres_of(opts, &rest);
     // Where each goes in the row, and from which block (no division a pixel).
     let rest_at: Vec<usize> = rest.iter().map(|&i| (i - area.x) as usize).collect();
     let picked_at: Vec<(usize, usize)> = picked
@@ -104,18 +105,18 @@ pub fn accumulate_first_around<T: SampleTracer + ?Sized>(
             (a as usize, (a / lattice.factor) as usize)
         })
         .collect();
-    let j0 = opts.image.height - (area.y + area.height);
-    render::for_each_row(opts, area, sums, 1, 1, control, |j, row, counts| {
+    let j0 = opts.height - (area.y + area.height);
+    render::bands::for_each_row(opts, area, sums, 1, 1, control, |j, row, counts| {
         let r = j - j0;
         if !lattice.holds(r, area.height) {
-            render::first_samples(tracer, opts, &all, &all_centres, j, row, counts);
+            render::progressive::first_samples(tracer, opts, &all, &all_centres, j, row, counts);
             after_row(j, row);
             return;
         }
         // Traced into the front of the row, then moved to their places from the last
         // one down (each place lies at or after its value's, so nothing unread is
         // overwritten): no buffer a row.
-        render::first_samples(
+        render::progressive::first_samples(
             tracer,
             opts,
             &rest,

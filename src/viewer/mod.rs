@@ -360,7 +360,7 @@ impl ApplicationHandler<Report> for App {
         if self.window.is_some() {
             return;
         }
-        let (w, h) = (self.scene.image.width, self.scene.image.height);
+        let (w, h) = (self.scene.settings().width, self.scene.settings().height);
         let attributes = Window::default_attributes()
             .with_title(status::title(&self.scene.name, w, h, &Progress::Rendering))
             .with_inner_size(PhysicalSize::new(w, h));

@@ -12,9 +12,9 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use crate::camera::Camera;
-use crate::render::{self, Frame, RenderControl, RenderError, RenderOptions, Renderer};
+use crate::render::{self, Frame, RenderControl, RenderError};
 use crate::scene::Scene;
+use crate::settings::{Precision, Settings};
 use crate::trace::fast::FastTracer;
 use crate::trace::SampleTracer;
 
@@ -152,9 +152,9 @@ fn serve(rx: Receiver<Job>, sink: impl Fn(Report)) {
         }
         match run(&job, &mut cache, &mut buffers, &sink) {
             Ok(()) | Err(RenderError::Cancelled) => {}
-            Err(RenderError::Invalid(message)) => sink(Report::Failed {
+            Err(e) => sink(Report::Failed {
                 generation: job.generation,
-                message,
+                message: e.to_string(),
             }),
         }
     }
@@ -170,14 +170,9 @@ pub struct TracerCache {
 }
 
 impl TracerCache {
-    fn tracer(
-        &mut self,
-        scene: &Arc<Scene>,
-        opts: &RenderOptions,
-    ) -> Result<&FastTracer, RenderError> {
-        let camera = Camera::for_scene(scene, opts.image.width, opts.image.height)
-            .map_err(|m| RenderError::Invalid(format!("camera: {m}")))?;
-        let depth = opts.image.max_depth;
+    fn tracer(&mut self, scene: &Arc<Scene>, opts: &Settings) -> Result<&FastTracer, RenderError> {
+        let camera = scene.camera(opts.width, opts.height)?;
+        let depth = opts.quality.max_depth;
         let tracer = match self.last.take() {
             Some((s, previous)) if same_contents(&s, scene) => previous.with_camera(&camera, depth),
             _ => {
@@ -185,7 +180,7 @@ impl TracerCache {
                 FastTracer::new(scene, &camera, depth)
             }
         }
-        .with_cutoff(opts.cutoff);
+        .with_cutoff(opts.quality.cutoff);
         Ok(&self.last.insert((Arc::clone(scene), tracer)).1)
     }
 }
@@ -260,18 +255,18 @@ pub fn run(
     sink: &dyn Fn(Report),
 ) -> Result<(), RenderError> {
     let scene = job.scene.as_ref();
-    let mut opts = RenderOptions::for_scene(scene);
-    opts.image.width = job.width;
-    opts.image.height = job.height;
+    let mut opts = scene.settings();
+    opts.width = job.width;
+    opts.height = job.height;
     opts.check()?;
     // The fast tracer comes from the cache; the f64 reference (a `reference` quality)
     // is built for each view.
-    match opts.renderer {
-        Renderer::Fast => {
+    match opts.quality.precision {
+        Precision::Fast => {
             let tracer = cache.tracer(&job.scene, &opts)?;
             passes(job, tracer, &opts, buffers, sink)
         }
-        Renderer::Reference => {
+        Precision::Reference => {
             let reference = render::make_tracer(scene, &opts)?;
             passes(job, reference.as_ref(), &opts, buffers, sink)
         }
@@ -283,13 +278,13 @@ pub fn run(
 fn passes<T: SampleTracer + ?Sized>(
     job: &Job,
     tracer: &T,
-    opts: &RenderOptions,
+    opts: &Settings,
     buffers: &mut Buffers,
     sink: &dyn Fn(Report),
 ) -> Result<(), RenderError> {
     let control = job.control.as_ref();
     let (w, h) = (job.width, job.height);
-    let target = opts.image.spp;
+    let target = opts.quality.spp;
     let passes = plan(w, h, target, job.preview_factor);
     let last = passes.len() - 1;
     buffers.sums.resize(w as usize * h as usize, Vec3::ZERO);
@@ -376,14 +371,14 @@ fn passes<T: SampleTracer + ?Sized>(
 #[allow(clippy::type_complexity)]
 fn trace_pass<T: SampleTracer + ?Sized>(
     tracer: &T,
-    opts: &RenderOptions,
+    opts: &Settings,
     buffers: &mut Buffers,
     previewed: &mut Option<Lattice>,
     pass: Pass,
     screen: Option<&mut Vec<u8>>,
     control: &RenderControl,
 ) -> Result<(u32, u64, Option<(u32, u32)>), RenderError> {
-    let (w, h) = (opts.image.width, opts.image.height);
+    let (w, h) = (opts.width, opts.height);
     let screen = screen.map(|rgba| ScreenRows::new(rgba, w, h));
     let after_row = |j: u32, row: &mut [Vec3]| {
         if let Some(screen) = &screen {
@@ -469,7 +464,7 @@ mod tests {
     #[test]
     fn the_last_pass_equals_a_one_shot_render() {
         let mut scene = hw3_scene(HW3_DEFAULT_SEED);
-        scene.image.spp = 5;
+        scene.image.spp = Some(5);
         let (w, h) = (192, 108);
         let shown = collect(scene.clone(), w, h);
         // Preview, then samples 1, 2, 4, 5.
@@ -477,9 +472,9 @@ mod tests {
         assert_eq!(counts, vec![0, 1, 2, 4, 5]);
         assert!(shown[0].preview && !shown[1].preview);
         assert!(shown.last().unwrap().done && !shown[3].done);
-        let mut opts = RenderOptions::for_scene(&scene);
-        opts.image.width = w;
-        opts.image.height = h;
+        let mut opts = scene.settings();
+        opts.width = w;
+        opts.height = h;
         let (expected, _) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
         assert_eq!(*shown.last().unwrap().frame, expected);
         // The 1-sample pass is the first sample of the 5-spp pattern (its lattice
@@ -512,14 +507,14 @@ mod tests {
     fn one_sample_views_take_the_preview_pixels_into_the_full_frame() {
         // One sample a pixel (the orbit's case: a row at a time through the tracer),
         // sizes that do not divide by the factor, the fast and the reference tracer.
-        for renderer in [Renderer::Fast, Renderer::Reference] {
+        for renderer in [Precision::Fast, Precision::Reference] {
             let mut scene = hw3_scene(HW3_DEFAULT_SEED);
-            scene.image.spp = 1;
+            scene.image.spp = Some(1);
             let (w, h) = (190, 107);
             let job = |s: &Scene| Job::new(1, Arc::new(s.clone()), (w, h), 3);
-            let mut opts = RenderOptions::for_scene(&scene);
-            (opts.image.width, opts.image.height) = (w, h);
-            opts.renderer = renderer;
+            let mut opts = scene.settings();
+            (opts.width, opts.height) = (w, h);
+            opts.quality.precision = renderer;
             let shown = Mutex::new(Vec::new());
             let sink = |r: Report| match r {
                 Report::Frame(s) => shown.lock().unwrap().push(s),
@@ -560,7 +555,7 @@ mod tests {
             // Every pass of each job, with fresh buffers: what the reused ones must give.
             // 192×108 has a preview; 96×54 has none and reuses larger buffers.
             let mut scene = hw3_scene(HW3_DEFAULT_SEED);
-            scene.image.spp = spp;
+            scene.image.spp = Some(spp);
             let jobs = [(192, 108), (192, 108), (96, 54), (192, 108)];
             let fresh: Vec<Vec<Shown>> = jobs
                 .iter()
@@ -623,7 +618,7 @@ mod tests {
         // render of it; a moved sphere is compiled afresh.
         use crate::viewer::controls::{Action, CameraControl};
         let mut base = hw3_scene(HW3_DEFAULT_SEED);
-        base.image.spp = 1;
+        base.image.spp = Some(1);
         let (w, h) = (96, 54);
         let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
         let mut camera = CameraControl::new(&base);
@@ -636,8 +631,8 @@ mod tests {
             let job = Job::new(n, Arc::new(scene.clone()), (w, h), 4);
             run(&job, cache, &mut buffers, &sink).unwrap();
             let last = shown.into_inner().unwrap().pop().unwrap();
-            let mut opts = RenderOptions::for_scene(scene);
-            (opts.image.width, opts.image.height) = (w, h);
+            let mut opts = scene.settings();
+            (opts.width, opts.height) = (w, h);
             let (expected, _) = render::render(scene, &opts, &RenderControl::default()).unwrap();
             assert_eq!(*last.frame, expected, "view {n}");
         };
@@ -677,7 +672,7 @@ mod tests {
         // the screen buffer before it traces).
         for (spp, factor) in [(2, 4), (1, 1)] {
             let mut scene = hw3_scene(HW3_DEFAULT_SEED);
-            scene.image.spp = spp;
+            scene.image.spp = Some(spp);
             let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
             let scene = Arc::new(scene);
             let first = Job::new(1, Arc::clone(&scene), (192, 108), factor);
@@ -686,15 +681,15 @@ mod tests {
             assert!(pooled.0 > 0 && pooled.1 > 0);
             // The next view is cancelled inside its first pass.
             let second = Job::new(2, Arc::clone(&scene), (192, 108), factor);
-            let mut opts = RenderOptions::for_scene(&scene);
-            (opts.image.width, opts.image.height) = (192, 108);
+            let mut opts = scene.settings();
+            (opts.width, opts.height) = (192, 108);
             let tracer = Cancelling {
                 tracer: cache.tracer(&scene, &opts).unwrap(),
                 control: &second.control,
             };
             let shown = |_: Report| panic!("a cancelled pass was shown");
             let result = passes(&second, &tracer, &opts, &mut buffers, &shown);
-            assert_eq!(result, Err(RenderError::Cancelled));
+            assert!(matches!(result, Err(RenderError::Cancelled)), "{result:?}");
             let now = (buffers.frames.sent.len(), buffers.rgba.sent.len());
             assert_eq!(now, pooled, "spp {spp}, preview factor {factor}");
             assert!(buffers.frames.take().is_some() && buffers.rgba.take().is_some());
@@ -708,10 +703,10 @@ mod tests {
             let _ = tx.send(r);
         });
         let mut big = hw3_scene(HW3_DEFAULT_SEED);
-        big.image.spp = 64;
+        big.image.spp = Some(64);
         worker.submit(1, Arc::new(big), (640, 360), 4);
         let mut small = hw3_scene(HW3_DEFAULT_SEED);
-        small.image.spp = 1;
+        small.image.spp = Some(1);
         worker.submit(2, Arc::new(small), (32, 18), 4);
         // The small job completes; the big one never reaches its last pass.
         loop {

@@ -9,8 +9,10 @@ pub mod cases;
 use std::path::PathBuf;
 
 use glam::{DVec3, Vec3};
-use whitted::render::{self, RenderControl, RenderOptions, Renderer};
-use whitted::scene::{self, CameraSpec, Light, Scene, Sphere};
+use whitted::camera::CameraSpec;
+use whitted::render::{self, RenderControl};
+use whitted::scene::{self, Light, Scene, Sphere};
+use whitted::settings::Precision;
 
 /// The folder of the stress scenes.
 pub fn stress_dir() -> PathBuf {
@@ -240,7 +242,7 @@ pub fn stress_scenes() -> Vec<Stress> {
                 up: DVec3::Y,
                 vfov: 70.0,
             });
-            s.image.max_depth = 64;
+            s.image.max_depth = Some(64);
             // Between the mirrors (the default light would sit inside the left one).
             s.lights = vec![Light {
                 position: DVec3::new(0.0, 5.0, 0.0),
@@ -338,12 +340,12 @@ pub struct Rendered {
     pub seconds: f64,
 }
 
-pub fn render_with(scene: &Scene, width: u32, height: u32, renderer: Renderer) -> Rendered {
-    let mut opts = RenderOptions::for_scene(scene);
-    opts.image.width = width;
-    opts.image.height = height;
-    opts.image.spp = 1;
-    opts.renderer = renderer;
+pub fn render_with(scene: &Scene, width: u32, height: u32, renderer: Precision) -> Rendered {
+    let mut opts = scene.settings();
+    opts.width = width;
+    opts.height = height;
+    opts.quality.spp = 1;
+    opts.quality.precision = renderer;
     opts.check().expect("valid options");
     let control = RenderControl::default();
     let start = std::time::Instant::now();
@@ -391,7 +393,7 @@ pub const TRANSFORMS: [(&str, f64, [f64; 3]); 3] = [
 /// at most `limit_fraction` of the pixels are off by more than one level; prints a
 /// table row per transform. `cases` picks transforms by name.
 pub fn check_transforms(
-    renderer: Renderer,
+    renderer: Precision,
     cases: &[&str],
     width: u32,
     height: u32,
@@ -440,8 +442,8 @@ pub fn check_fast_vs_reference(names: &[&str], width: u32, height: u32) -> Vec<S
     {
         let scene = Scene::load(&stress_dir().join(format!("{}.toml", s.name)))
             .unwrap_or_else(|e| panic!("{e}"));
-        let fast = render_with(&scene, width, height, Renderer::Fast);
-        let reference = render_with(&scene, width, height, Renderer::Reference);
+        let fast = render_with(&scene, width, height, Precision::Fast);
+        let reference = render_with(&scene, width, height, Precision::Reference);
         let (off, max) = pixels_off(&fast.rgb, &reference.rgb);
         let non_finite = fast.non_finite + reference.non_finite;
         println!(

@@ -1,0 +1,364 @@
+//! The frame: pixels in bands on rayon, samples per pixel, progress and cancellation,
+//! and the linear RGB buffer. Row 0 of every buffer here is the BOTTOM row of the
+//! image (`j = 0`, as in GLUT); the file writers and the window flip it, once.
+//!
+//! [`render`] takes a scene and resolved [`Settings`]; the submodules are its steps:
+//! [`bands`] (rows over threads), [`film`] (where samples land), [`adaptive`]
+//! (anti-aliasing where it matters), [`resolve`] (sums to finite pixel values) and
+//! [`progressive`] (sums kept between the passes of a progressive render).
+
+mod adaptive;
+pub(crate) mod bands;
+pub(crate) mod film;
+mod frame;
+pub(crate) mod progressive;
+mod resolve;
+
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Instant;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::camera::CameraError;
+use crate::scene::Scene;
+use crate::settings::{Precision, Settings, SettingsError};
+use crate::trace::fast::FastTracer;
+use crate::trace::reference::ReferenceTracer;
+use crate::trace::{RayCounts, SampleTracer};
+use adaptive::adaptive;
+use bands::{for_each_pixel, for_each_row, in_pool};
+use film::{centre_height, film, pixel_centres};
+
+pub use adaptive::first_pass_samples;
+pub use frame::Frame;
+pub use progressive::{accumulate, accumulate_first};
+pub use resolve::{mend_non_finite, pixel_value, pixel_values, resolve};
+
+/// Why a render did not finish.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// Settings that [`Settings::check`] refuses.
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    /// The scene's camera cannot make an image of this size.
+    #[error("camera: {0}")]
+    Camera(#[from] CameraError),
+    /// The thread pool could not be started.
+    #[error("cannot start {threads} threads: {source}")]
+    Threads {
+        /// Threads asked for.
+        threads: usize,
+        /// What the pool builder said.
+        source: rayon::ThreadPoolBuildError,
+    },
+    /// [`RenderControl::cancel`] was called.
+    #[error("render cancelled")]
+    Cancelled,
+}
+
+/// Shared between a render and whoever watches it: progress out, cancellation in.
+#[derive(Debug, Default)]
+pub struct RenderControl {
+    cancel: AtomicBool,
+    pub(crate) pixels_done: AtomicU64,
+}
+
+impl RenderControl {
+    /// Asks the render to stop; it returns [`RenderError::Cancelled`] within a row.
+    pub fn cancel(&self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether [`RenderControl::cancel`] was called.
+    pub fn is_cancelled(&self) -> bool {
+        self.cancel.load(Ordering::Relaxed)
+    }
+
+    /// Pixel-samples finished so far (a pixel counts once per sample pass).
+    pub fn pixels_done(&self) -> u64 {
+        self.pixels_done.load(Ordering::Relaxed)
+    }
+}
+
+/// What a render cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Rays cast, by kind.
+    pub rays: RayCounts,
+    /// Wall time of the whole render, preparation included.
+    pub seconds: f64,
+    /// Of which: compiling the scene for the tracer (acceleration structures).
+    pub build_seconds: f64,
+}
+
+impl RenderStats {
+    /// Rays cast a second of wall time, in millions.
+    pub fn mrays_per_second(&self) -> f64 {
+        self.rays.total() as f64 / self.seconds.max(1e-9) / 1e6
+    }
+}
+
+/// Builds the tracer that `settings` asks for.
+pub fn make_tracer<'a>(
+    scene: &'a Scene,
+    settings: &Settings,
+) -> Result<Box<dyn SampleTracer + 'a>, RenderError> {
+    Ok(match Tracer::new(scene, settings)? {
+        Tracer::Fast(t) => Box::new(t),
+        Tracer::Reference(t) => Box::new(t),
+    })
+}
+
+/// The tracer of a render, by type: the pixel loops are compiled for each, so that the
+/// per-sample call is direct and inlined (a virtual call per sample costs a tenth of a
+/// 1-sample frame).
+enum Tracer<'a> {
+    Fast(FastTracer),
+    Reference(ReferenceTracer<'a>),
+}
+
+impl<'a> Tracer<'a> {
+    fn new(scene: &'a Scene, settings: &Settings) -> Result<Self, RenderError> {
+        let camera = scene.camera(settings.width, settings.height)?;
+        let depth = settings.quality.max_depth;
+        Ok(match settings.quality.precision {
+            Precision::Fast => Tracer::Fast(
+                FastTracer::new(scene, &camera, depth).with_cutoff(settings.quality.cutoff),
+            ),
+            Precision::Reference => Tracer::Reference(ReferenceTracer::new(scene, camera, depth)),
+        })
+    }
+}
+
+/// A render with what its quality settings cost in accuracy and saved in work.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rendered {
+    /// The pixels of the area rendered.
+    pub frame: Frame,
+    /// For each pixel (same layout as the frame), a bound of the error the contribution
+    /// cutoff caused: `|exact − value| ≤ bound` in every colour component, before
+    /// clamping and rounding. All zero without a cutoff.
+    pub cutoff_bound: Vec<f32>,
+    /// Pixels that got more than the first pass of adaptive anti-aliasing (all of them
+    /// without it).
+    pub refined: u64,
+    /// What the render cost.
+    pub stats: RenderStats,
+}
+
+/// Renders the area of `settings` with all its samples.
+pub fn render(
+    scene: &Scene,
+    settings: &Settings,
+    control: &RenderControl,
+) -> Result<(Frame, RenderStats), RenderError> {
+    let r = render_bounded(scene, settings, control)?;
+    Ok((r.frame, r.stats))
+}
+
+/// Renders the area of `settings` and reports the cutoff's error bound per pixel and how
+/// many pixels adaptive anti-aliasing refined.
+pub fn render_bounded(
+    scene: &Scene,
+    settings: &Settings,
+    control: &RenderControl,
+) -> Result<Rendered, RenderError> {
+    settings.check()?;
+    let start = Instant::now();
+    // The build runs on the render's threads too: `--threads 1` means one thread.
+    let tracer = in_pool(settings, || Tracer::new(scene, settings))??;
+    let build_seconds = start.elapsed().as_secs_f64();
+    let Traced {
+        frame,
+        cutoff_bound,
+        refined,
+        rays,
+    } = match &tracer {
+        Tracer::Fast(t) => render_with(t, settings, control)?,
+        Tracer::Reference(t) => render_with(t, settings, control)?,
+    };
+    Ok(Rendered {
+        frame,
+        cutoff_bound,
+        refined,
+        stats: RenderStats {
+            rays,
+            seconds: start.elapsed().as_secs_f64(),
+            build_seconds,
+        },
+    })
+}
+
+/// What the pixel loops of a render give back.
+struct Traced {
+    frame: Frame,
+    /// See [`Rendered::cutoff_bound`].
+    cutoff_bound: Vec<f32>,
+    /// See [`Rendered::refined`].
+    refined: u64,
+    rays: RayCounts,
+}
+
+/// The area of `settings` rendered with `tracer`.
+fn render_with<T: SampleTracer>(
+    tracer: &T,
+    settings: &Settings,
+    control: &RenderControl,
+) -> Result<Traced, RenderError> {
+    let area = settings.area();
+    let spp = settings.quality.spp;
+    let n = area.width as usize * area.height as usize;
+    let frame = |pixels| Frame {
+        width: area.width,
+        height: area.height,
+        pixels,
+    };
+    match settings.quality.adaptive {
+        Some(a) if a.first < spp => adaptive(tracer, settings, a, control),
+        _ if settings.quality.cutoff == 0.0
+            || settings.quality.precision == Precision::Reference =>
+        {
+            // Nothing is skipped, so every bound is 0: the pixels are written in place
+            // (zeroed in parallel: on two cores a serial fill of a 1280×720 frame costs
+            // a tenth of the render).
+            let mut pixels: Vec<Vec3> = in_pool(settings, || {
+                (0..n).into_par_iter().map(|_| Vec3::ZERO).collect()
+            })?;
+            let centres = pixel_centres(settings, area);
+            let rays = for_each_row(
+                settings,
+                area,
+                &mut pixels,
+                1,
+                u64::from(spp),
+                control,
+                |j, row, counts| {
+                    if spp == 1 {
+                        // The pixel centres: `film` for one sample, with the columns'
+                        // positions worked out once (same values, no division), and
+                        // the row at once, which lets the tracer share work.
+                        tracer.sample_row(&centres, centre_height(settings, j), row, counts);
+                        mend_non_finite(row);
+                        return;
+                    }
+                    for (a, p) in row.iter_mut().enumerate() {
+                        let i = area.x + a as u32;
+                        let mut sum = Vec3::ZERO;
+                        for k in 0..spp {
+                            let (s, t) = film(settings, i, j, k);
+                            sum += tracer.sample(s, t, counts);
+                        }
+                        *p = pixel_value(sum, spp);
+                    }
+                },
+            )?;
+            Ok(Traced {
+                frame: frame(pixels),
+                cutoff_bound: vec![0.0; n],
+                refined: n as u64,
+                rays,
+            })
+        }
+        _ => {
+            let mut acc: Vec<(Vec3, f32)> = in_pool(settings, || {
+                (0..n).into_par_iter().map(|_| (Vec3::ZERO, 0.0)).collect()
+            })?;
+            let rays = for_each_pixel(
+                settings,
+                area,
+                &mut acc,
+                1,
+                u64::from(spp),
+                control,
+                |i, j, p, counts| {
+                    let (sum, bound) = &mut p[0];
+                    for k in 0..spp {
+                        let (s, t) = film(settings, i, j, k);
+                        let (c, b) = tracer.sample_bounded(s, t, counts);
+                        *sum += c;
+                        *bound += b;
+                    }
+                },
+            )?;
+            let (pixels, bounds) = in_pool(settings, || {
+                acc.par_iter()
+                    .map(|p| (pixel_value(p.0, spp), p.1 / spp as f32))
+                    .unzip()
+            })?;
+            Ok(Traced {
+                frame: frame(pixels),
+                cutoff_bound: bounds,
+                refined: n as u64,
+                rays,
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A tracer whose samples are NaN or infinite in some places.
+    struct Poisoned;
+
+    impl SampleTracer for Poisoned {
+        fn sample(&self, s: f32, t: f32, _: &mut RayCounts) -> Vec3 {
+            match ((s * 10.0) as u32 + (t * 10.0) as u32) % 4 {
+                0 => Vec3::new(f32::NAN, 0.5, 0.5),
+                1 => Vec3::new(0.25, f32::INFINITY, 0.5),
+                2 => Vec3::new(0.25, 0.5, f32::NEG_INFINITY),
+                _ => Vec3::new(s, t, 0.5),
+            }
+        }
+    }
+
+    #[test]
+    fn pixel_values_of_a_row_are_each_pixel_value() {
+        let sums = [
+            Vec3::new(0.5, 1.5, 3.0),
+            Vec3::new(f32::NAN, 0.25, 0.0),
+            Vec3::new(1.0, f32::INFINITY, 2.0),
+            Vec3::new(-0.0, 7.0, 1e-30),
+        ];
+        for samples in [0, 1, 3] {
+            let mut out = [Vec3::splat(9.0); 4];
+            pixel_values(&sums, samples, &mut out);
+            for (k, (&o, &s)) in out.iter().zip(&sums).enumerate() {
+                let want = pixel_value(s, samples);
+                assert_eq!(
+                    o.to_array().map(f32::to_bits),
+                    want.to_array().map(f32::to_bits)
+                );
+                assert!(o.is_finite(), "samples {samples}, pixel {k}");
+            }
+        }
+        // With one sample, a finite sum is its own value; a poisoned one is black.
+        let mut out = [Vec3::ZERO; 4];
+        pixel_values(&sums, 1, &mut out);
+        assert_eq!(
+            [out[0], out[1], out[2], out[3]],
+            [sums[0], Vec3::ZERO, Vec3::ZERO, sums[3]]
+        );
+    }
+
+    #[test]
+    fn no_nan_or_infinity_reaches_a_frame() {
+        for spp in [1, 2] {
+            let mut settings = crate::scene::hw3_scene(0).settings();
+            (settings.width, settings.height, settings.quality.spp) = (20, 10, spp);
+            let frame = render_with(&Poisoned, &settings, &RenderControl::default())
+                .unwrap()
+                .frame;
+            let finite = frame.pixels.iter().filter(|p| p.is_finite()).count();
+            assert_eq!(finite, 200, "spp {spp}");
+            let black = frame.pixels.iter().filter(|&&p| p == Vec3::ZERO).count();
+            let sane = frame.pixels.iter().filter(|p| p.z == 0.5).count();
+            assert!(
+                black > 50 && sane > 20 && black + sane == 200,
+                "spp {spp}: {black} {sane}"
+            );
+        }
+    }
+}

@@ -1,0 +1,572 @@
+//! What a render is asked to do: image size, sampling, depth, precision, the part of
+//! the image and the threads, as one resolved [`Settings`] value.
+//!
+//! Settings come in layers of [`Overrides`]: the SPEC's defaults, then a scene file's
+//! `[image]` table, then the command line's (or a Python call's) options. Each layer
+//! may name a quality [`Preset`] and set single values; within a layer the preset comes
+//! first and the single values override it, and a later layer overrides an earlier
+//! one. [`Settings::with`] is the one place where a layer is applied, and
+//! [`Settings::check`] the one place where the result is validated.
+//!
+//! This module is a leaf: it knows nothing of scenes, cameras or tracers.
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::limits::{MAX_DEPTH, MAX_PIXELS, MAX_SIDE, MAX_SPP};
+
+/// Which implementation of the model renders (SPEC §2: both compute the same function).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Precision {
+    /// The fast `f32` tracer.
+    #[default]
+    Fast,
+    /// The `f64` reference tracer (slow; for measuring error).
+    Reference,
+}
+
+/// Adaptive anti-aliasing: every pixel first gets `first` samples spread over it; only
+/// pixels whose first samples, or whose 4-neighbours' means, differ by `threshold` or
+/// more (largest colour component, linear values clamped to [0,1]) get the rest of the
+/// `spp` samples. `threshold = 0` refines every pixel, which is plain anti-aliasing
+/// bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Adaptive {
+    /// Samples of the first pass.
+    pub first: u32,
+    /// Difference (linear, largest component) from which a pixel is refined.
+    pub threshold: f32,
+}
+
+impl Adaptive {
+    /// Samples in the first pass unless told otherwise: a 2×2 spread.
+    pub const FIRST: u32 = 4;
+
+    /// The usual first pass with the given threshold.
+    pub fn with_threshold(threshold: f32) -> Self {
+        Adaptive {
+            first: Self::FIRST,
+            threshold,
+        }
+    }
+}
+
+/// The knobs that trade run time for error: one point of the trade-off that
+/// `whitted bench` measures, and what a [`Preset`] names.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quality {
+    /// Samples per pixel (stratified and jittered beyond 1).
+    pub spp: u32,
+    /// `None`: every pixel gets `spp` samples.
+    pub adaptive: Option<Adaptive>,
+    /// Contribution cutoff ε: branches of path weight below it are not traced
+    /// (0: exact). The fast tracer only; the reference traces everything.
+    pub cutoff: f32,
+    /// Maximum ray depth (SPEC §2: `trace` returns the sky at this depth).
+    pub max_depth: u32,
+    /// The tracer.
+    pub precision: Precision,
+}
+
+impl Default for Quality {
+    /// The SPEC's defaults: one centred sample, depth 5, everything exact.
+    fn default() -> Self {
+        Quality {
+            spp: 1,
+            adaptive: None,
+            cutoff: 0.0,
+            max_depth: 5,
+            precision: Precision::Fast,
+        }
+    }
+}
+
+impl Quality {
+    /// A short, unique, file-name-safe label such as `fast-spp16-aa0.03-eps0.01-d5`.
+    pub fn label(&self) -> String {
+        let mut s = match self.precision {
+            Precision::Fast => "fast".to_string(),
+            Precision::Reference => "f64".to_string(),
+        };
+        s += &format!("-spp{}", self.spp);
+        if let Some(a) = self.adaptive {
+            s += &format!("-aa{}", a.threshold);
+            if a.first != Adaptive::FIRST {
+                s += &format!("f{}", a.first);
+            }
+        }
+        if self.cutoff > 0.0 {
+            s += &format!("-eps{}", self.cutoff);
+        }
+        s += &format!("-d{}", self.max_depth);
+        s
+    }
+
+    fn check(&self) -> Result<(), SettingsError> {
+        if self.spp == 0 || self.spp > MAX_SPP {
+            return Err(SettingsError::Spp(self.spp));
+        }
+        if self.max_depth > MAX_DEPTH {
+            return Err(SettingsError::Depth(self.max_depth));
+        }
+        if !(self.cutoff.is_finite() && self.cutoff >= 0.0) {
+            return Err(SettingsError::Cutoff(self.cutoff));
+        }
+        if let Some(a) = self.adaptive {
+            if !(a.threshold.is_finite() && a.threshold >= 0.0) {
+                return Err(SettingsError::AdaptiveThreshold(a.threshold));
+            }
+            if a.first == 0 {
+                return Err(SettingsError::AdaptiveFirst);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The named presets (`--quality`, `quality = "…"` in a scene file).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Preset {
+    /// Interactive previews: one centred sample, depth 5, everything exact (the
+    /// SPEC's defaults, what a render without options does).
+    Draft,
+    /// The knee of the measured time/error front on 3 of the 4 study scenes (and next
+    /// to it on the fourth): RMSE about one 8-bit level.
+    Default,
+    /// The cheapest setting within 10% of the best error the fast tracer reached in
+    /// the study (at a third of the time of 64 plain samples).
+    High,
+    /// The converged reference of the study: f64, 256 stratified spp, depth 16.
+    Reference,
+}
+
+impl Preset {
+    /// Every preset, cheapest first.
+    pub const ALL: [Preset; 4] = [
+        Preset::Draft,
+        Preset::Default,
+        Preset::High,
+        Preset::Reference,
+    ];
+
+    /// The name in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Draft => "draft",
+            Preset::Default => "default",
+            Preset::High => "high",
+            Preset::Reference => "reference",
+        }
+    }
+
+    /// The settings of the preset. The values come from the study in docs/quality.md
+    /// (`whitted bench`); re-run it before changing them.
+    pub fn quality(self) -> Quality {
+        match self {
+            Preset::Draft => Quality::default(),
+            Preset::Default => Quality {
+                spp: 16,
+                adaptive: Some(Adaptive::with_threshold(0.1)),
+                cutoff: 0.0,
+                max_depth: 16,
+                precision: Precision::Fast,
+            },
+            Preset::High => Quality {
+                spp: 64,
+                adaptive: Some(Adaptive::with_threshold(0.03)),
+                cutoff: 0.0,
+                max_depth: 16,
+                precision: Precision::Fast,
+            },
+            Preset::Reference => Quality {
+                spp: 256,
+                adaptive: None,
+                cutoff: 0.0,
+                max_depth: 16,
+                precision: Precision::Reference,
+            },
+        }
+    }
+}
+
+impl fmt::Display for Preset {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A name that is not one of the [`Preset`]s.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown quality \"{0}\": expected draft, default, high or reference")]
+pub struct UnknownPreset(pub String);
+
+impl FromStr for Preset {
+    type Err = UnknownPreset;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Preset::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| UnknownPreset(s.to_string()))
+    }
+}
+
+/// A rectangle of the output image in image-tool coordinates: origin at the TOP-left.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Region {
+    /// Left column.
+    pub x: u32,
+    /// Top row, counted from the top.
+    pub y: u32,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+}
+
+/// Everything a render needs besides the scene, resolved from the layers of
+/// [`Overrides`] and checked by [`Settings::check`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Seed of the sample jitter.
+    pub seed: u64,
+    /// Samples, anti-aliasing, cutoff, depth and precision.
+    pub quality: Quality,
+    /// Render only this rectangle of the image (`None`: all of it).
+    pub region: Option<Region>,
+    /// Worker threads (`None`: all cores).
+    pub threads: Option<usize>,
+}
+
+impl Default for Settings {
+    /// The SPEC's defaults: 1280×720, seed 0, [`Quality::default`], the whole image on
+    /// all cores.
+    fn default() -> Self {
+        Settings {
+            width: 1280,
+            height: 720,
+            seed: 0,
+            quality: Quality::default(),
+            region: None,
+            threads: None,
+        }
+    }
+}
+
+/// One layer of settings: what a scene file's `[image]` table, a command line or a
+/// Python call says. Every field is optional; a preset applies first, then the single
+/// values.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Overrides {
+    /// A quality preset, applied before the values below.
+    pub quality: Option<Preset>,
+    /// Image width in pixels.
+    pub width: Option<u32>,
+    /// Image height in pixels.
+    pub height: Option<u32>,
+    /// Samples per pixel.
+    pub spp: Option<u32>,
+    /// Maximum ray depth.
+    pub max_depth: Option<u32>,
+    /// Seed of the sample jitter.
+    pub seed: Option<u64>,
+    /// The tracer.
+    pub precision: Option<Precision>,
+    /// Render only this rectangle.
+    pub region: Option<Region>,
+    /// Worker threads.
+    pub threads: Option<usize>,
+}
+
+impl Overrides {
+    /// `later` laid over this layer, as one layer: for every `s`,
+    /// `s.with(&a.then(&b)) == s.with(&a).with(&b)`. A preset in `later` replaces what
+    /// this layer set of the preset's knobs (samples, depth, precision).
+    pub fn then(&self, later: &Overrides) -> Overrides {
+        let base = if later.quality.is_some() {
+            Overrides {
+                quality: later.quality,
+                spp: None,
+                max_depth: None,
+                precision: None,
+                ..*self
+            }
+        } else {
+            *self
+        };
+        Overrides {
+            quality: base.quality,
+            width: later.width.or(base.width),
+            height: later.height.or(base.height),
+            spp: later.spp.or(base.spp),
+            max_depth: later.max_depth.or(base.max_depth),
+            seed: later.seed.or(base.seed),
+            precision: later.precision.or(base.precision),
+            region: later.region.or(base.region),
+            threads: later.threads.or(base.threads),
+        }
+    }
+}
+
+impl Settings {
+    /// These settings with the layer `o` over them: its preset first, then its values.
+    pub fn with(mut self, o: &Overrides) -> Settings {
+        if let Some(preset) = o.quality {
+            self.quality = preset.quality();
+        }
+        let q = &mut self.quality;
+        q.spp = o.spp.unwrap_or(q.spp);
+        q.max_depth = o.max_depth.unwrap_or(q.max_depth);
+        q.precision = o.precision.unwrap_or(q.precision);
+        self.width = o.width.unwrap_or(self.width);
+        self.height = o.height.unwrap_or(self.height);
+        self.seed = o.seed.unwrap_or(self.seed);
+        self.region = o.region.or(self.region);
+        self.threads = o.threads.or(self.threads);
+        self
+    }
+
+    /// The rectangle to render (the whole image without a region).
+    pub fn area(&self) -> Region {
+        self.region.unwrap_or(Region {
+            x: 0,
+            y: 0,
+            width: self.width,
+            height: self.height,
+        })
+    }
+
+    /// Checks sizes, samples, depth, the region and the threads against [`crate::limits`]
+    /// before anything is allocated.
+    pub fn check(&self) -> Result<(), SettingsError> {
+        let (width, height) = (self.width, self.height);
+        if width == 0 || height == 0 {
+            return Err(SettingsError::EmptyImage { width, height });
+        }
+        if width > MAX_SIDE || height > MAX_SIDE {
+            return Err(SettingsError::SideTooLong { width, height });
+        }
+        if u64::from(width) * u64::from(height) > MAX_PIXELS {
+            return Err(SettingsError::TooManyPixels { width, height });
+        }
+        self.quality.check()?;
+        if let Some(r) = self.region {
+            let fits = r.width > 0
+                && r.height > 0
+                && u64::from(r.x) + u64::from(r.width) <= u64::from(width)
+                && u64::from(r.y) + u64::from(r.height) <= u64::from(height);
+            if !fits {
+                return Err(SettingsError::RegionOutside {
+                    region: r,
+                    width,
+                    height,
+                });
+            }
+        }
+        if self.threads == Some(0) {
+            return Err(SettingsError::NoThreads);
+        }
+        Ok(())
+    }
+}
+
+/// Settings that [`Settings::check`] refuses.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SettingsError {
+    /// A side of zero pixels.
+    #[error("image size {width}x{height} is empty: width and height must be at least 1")]
+    EmptyImage {
+        /// Width asked for.
+        width: u32,
+        /// Height asked for.
+        height: u32,
+    },
+    /// A side beyond [`MAX_SIDE`].
+    #[error("image size {width}x{height} is too large: each side must be at most {MAX_SIDE}")]
+    SideTooLong {
+        /// Width asked for.
+        width: u32,
+        /// Height asked for.
+        height: u32,
+    },
+    /// More than [`MAX_PIXELS`] pixels.
+    #[error("image size {width}x{height} is too large: at most {MAX_PIXELS} pixels")]
+    TooManyPixels {
+        /// Width asked for.
+        width: u32,
+        /// Height asked for.
+        height: u32,
+    },
+    /// Samples per pixel of 0 or beyond [`MAX_SPP`].
+    #[error("spp {0} is out of range: expected 1 to {MAX_SPP}")]
+    Spp(u32),
+    /// Depth beyond [`MAX_DEPTH`].
+    #[error("max_depth {0} is out of range: expected 0 to {MAX_DEPTH}")]
+    Depth(u32),
+    /// A negative or non-finite cutoff.
+    #[error("cutoff {0} is out of range: expected a number ≥ 0")]
+    Cutoff(f32),
+    /// A negative or non-finite adaptive threshold.
+    #[error("adaptive threshold {0} is out of range: expected a number ≥ 0")]
+    AdaptiveThreshold(f32),
+    /// An adaptive first pass of no samples.
+    #[error("adaptive first pass needs at least 1 sample")]
+    AdaptiveFirst,
+    /// A region that is empty or reaches outside the image.
+    #[error(
+        "region {},{},{},{} does not fit in the {width}x{height} image",
+        region.x, region.y, region.width, region.height
+    )]
+    RegionOutside {
+        /// The region asked for.
+        region: Region,
+        /// Image width.
+        width: u32,
+        /// Image height.
+        height: u32,
+    },
+    /// Zero worker threads.
+    #[error("threads must be at least 1")]
+    NoThreads,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn layer() -> impl Strategy<Value = Overrides> {
+        let preset = prop::option::of(prop::sample::select(Preset::ALL.to_vec()));
+        let small = || prop::option::of(0u32..100);
+        let precision = prop::option::of(prop::sample::select(vec![
+            Precision::Fast,
+            Precision::Reference,
+        ]));
+        (
+            preset,
+            (small(), small(), small(), small()),
+            prop::option::of(0u64..9),
+            precision,
+            prop::option::of((0u32..9, 0u32..9, 1u32..9, 1u32..9)),
+            prop::option::of(1usize..9),
+        )
+            .prop_map(
+                |(quality, (width, height, spp, max_depth), seed, precision, r, threads)| {
+                    Overrides {
+                        quality,
+                        width,
+                        height,
+                        spp,
+                        max_depth,
+                        seed,
+                        precision,
+                        region: r.map(|(x, y, width, height)| Region {
+                            x,
+                            y,
+                            width,
+                            height,
+                        }),
+                        threads,
+                    }
+                },
+            )
+    }
+
+    proptest! {
+        #[test]
+        fn two_layers_joined_apply_as_the_two_in_turn(a in layer(), b in layer()) {
+            let base = Settings::default();
+            prop_assert_eq!(
+                base.clone().with(&a.then(&b)),
+                base.with(&a).with(&b)
+            );
+        }
+    }
+
+    #[test]
+    fn a_preset_comes_before_the_values_of_its_layer_and_after_earlier_layers() {
+        let file = Overrides {
+            quality: Some(Preset::High),
+            spp: Some(3),
+            width: Some(64),
+            ..Overrides::default()
+        };
+        let s = Settings::default().with(&file);
+        assert_eq!((s.quality.spp, s.quality.max_depth, s.width), (3, 16, 64));
+        assert_eq!(s.quality.adaptive, Some(Adaptive::with_threshold(0.03)));
+
+        // A preset on the command line replaces the file's samples, keeps its size.
+        let cli = Overrides {
+            quality: Some(Preset::Reference),
+            ..Overrides::default()
+        };
+        let s = s.with(&cli);
+        assert_eq!((s.quality.spp, s.width), (256, 64));
+        assert_eq!(s.quality.precision, Precision::Reference);
+        assert_eq!(s.quality.adaptive, None);
+    }
+
+    #[test]
+    fn check_refuses_each_value_out_of_range() {
+        let ok = Settings::default();
+        assert_eq!(ok.check(), Ok(()));
+        let bad = |f: &dyn Fn(&mut Settings)| {
+            let mut s = Settings::default();
+            f(&mut s);
+            s.check().unwrap_err().to_string()
+        };
+        assert_eq!(
+            bad(&|s| s.width = 0),
+            "image size 0x720 is empty: width and height must be at least 1"
+        );
+        assert_eq!(
+            bad(&|s| s.height = MAX_SIDE + 1),
+            "image size 1280x65537 is too large: each side must be at most 65536"
+        );
+        assert_eq!(
+            bad(&|s| (s.width, s.height) = (MAX_SIDE, MAX_SIDE)),
+            "image size 65536x65536 is too large: at most 268435456 pixels"
+        );
+        assert_eq!(
+            bad(&|s| s.quality.spp = 0),
+            "spp 0 is out of range: expected 1 to 65536"
+        );
+        assert_eq!(
+            bad(&|s| s.quality.max_depth = MAX_DEPTH + 1),
+            "max_depth 65 is out of range: expected 0 to 64"
+        );
+        assert_eq!(
+            bad(&|s| s.quality.cutoff = f32::NAN),
+            "cutoff NaN is out of range: expected a number ≥ 0"
+        );
+        assert_eq!(
+            bad(&|s| s.quality.adaptive = Some(Adaptive::with_threshold(-1.0))),
+            "adaptive threshold -1 is out of range: expected a number ≥ 0"
+        );
+        assert_eq!(
+            bad(&|s| s.region = Some(Region {
+                x: 1200,
+                y: 700,
+                width: 81,
+                height: 20
+            })),
+            "region 1200,700,81,20 does not fit in the 1280x720 image"
+        );
+        assert_eq!(bad(&|s| s.threads = Some(0)), "threads must be at least 1");
+    }
+
+    #[test]
+    fn presets_parse_from_their_names_only() {
+        for p in Preset::ALL {
+            assert_eq!(p.name().parse::<Preset>(), Ok(p));
+        }
+        assert_eq!(
+            "best".parse::<Preset>().unwrap_err().to_string(),
+            "unknown quality \"best\": expected draft, default, high or reference"
+        );
+    }
+}
