@@ -53,9 +53,9 @@ fn check_input(text: &str, stats: &RefCell<Fuzzed>) -> Result<(), TestCaseError>
             s.rejected += 1;
             let line = e.to_string();
             prop_assert!(!line.contains('\n'), "multi-line error: {line:?}");
-            prop_assert!(e.location.starts_with(PATH), "no location: {line:?}");
+            prop_assert!(e.location().starts_with(PATH), "no location: {line:?}");
             prop_assert!(!e.message.trim().is_empty(), "empty message");
-            let rest = &e.location[PATH.len()..];
+            let rest = &e.location()[PATH.len()..];
             if let Some(line_col) = rest.strip_prefix(':') {
                 s.with_line_col += 1;
                 let parts: Vec<&str> = line_col.split(':').collect();
@@ -291,14 +291,14 @@ fn refused(text: &str) -> scene::SceneError {
 #[test]
 fn image_limits_are_refused_with_a_located_message() {
     let e = refused("[image]\nwidth = 100000\n");
-    assert_eq!(e.location, "fuzz.toml:2:9");
+    assert_eq!(e.location(), "fuzz.toml:2:9");
     assert!(
         e.message.contains("width") && e.message.contains("65536"),
         "{e}"
     );
     // Each side within its limit, the product beyond 2^28 pixels: no buffer is made.
     let e = refused("# big\n[image]\nwidth = 65536\nheight = 65536\n");
-    assert!(e.location.starts_with("fuzz.toml:2:"), "{e}");
+    assert!(e.location().starts_with("fuzz.toml:2:"), "{e}");
     assert!(e.message.contains("268435456 pixels"), "{e}");
     for text in [
         "[image]\nspp = 0\n",
@@ -311,7 +311,7 @@ fn image_limits_are_refused_with_a_located_message() {
         // The value's own position: line 2, after the key.
         let e = refused(text);
         let col = text[8..].find('=').unwrap() + 3;
-        assert_eq!(e.location, format!("fuzz.toml:2:{col}"), "{text:?}: {e}");
+        assert_eq!(e.location(), format!("fuzz.toml:2:{col}"), "{text:?}: {e}");
         println!("{text:?} -> {e}");
     }
     // The settings check itself, at the edge.
@@ -349,7 +349,7 @@ fn too_many_spheres_are_refused_before_parsing() {
         text.len() / 1_000_000
     );
     assert_eq!(
-        e.location,
+        e.location(),
         format!("fuzz.toml:{}:1", 3 * limits::MAX_SPHERES + 1)
     );
     assert!(
@@ -366,7 +366,7 @@ fn too_many_spheres_are_refused_before_parsing() {
     // Lights inline, few bytes each: refused by the bounded array, with a location.
     let lights = format!("light = [{}]\n", "{},".repeat(limits::MAX_LIGHTS + 1));
     let e = refused(&lights);
-    assert!(e.location.starts_with("fuzz.toml:1:"), "{e}");
+    assert!(e.location().starts_with("fuzz.toml:1:"), "{e}");
     assert!(e.message.contains("1024 lights"), "{e}");
     // At the limit it loads (streamed), and fast.
     let at_limit = Scene::from_toml_str(&one.repeat(1000), PATH).unwrap();

@@ -147,10 +147,34 @@ impl Scene {
 
 /// Why a scene could not be loaded: where (file, and line:column when known) and what.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{location}: {message}")]
+#[error("{}: {message}", self.location())]
 pub struct SceneError {
-    /// `file`, or `file:line:column`.
-    pub location: String,
+    /// The file, or the name the text was given.
+    pub path: String,
+    /// Line of the offending value, from 1 (`None`: the file as a whole).
+    pub line: Option<usize>,
+    /// Column of the offending value, in characters from 1.
+    pub column: Option<usize>,
     /// What is wrong.
     pub message: String,
+}
+
+impl SceneError {
+    /// An error about the file as a whole.
+    pub fn whole(path: impl Into<String>, message: impl Into<String>) -> Self {
+        SceneError {
+            path: path.into(),
+            line: None,
+            column: None,
+            message: message.into(),
+        }
+    }
+
+    /// `file`, or `file:line:column`.
+    pub fn location(&self) -> String {
+        match (self.line, self.column) {
+            (Some(line), Some(column)) => format!("{}:{line}:{column}", self.path),
+            _ => self.path.clone(),
+        }
+    }
 }

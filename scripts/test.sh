@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Every test of the project, as README's set-up and CI run them:
+#   1. the whole crate with its default features (the command line and the window);
+#   2. the core library alone (`--no-default-features`): its unit tests, the
+#      integration tests that need no binary, and the doc examples;
+#   3. the core's dependency tree holds none of the shells' crates.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+echo "== cargo test --release"
+cargo test --release
+
+echo "== cargo test --release --no-default-features (the core library)"
+cargo test --release --no-default-features
+
+echo "== the core's dependencies"
+shells="clap indicatif plotters nv-flip ctrlc winit pixels softbuffer anyhow"
+tree=$(cargo tree -e normal --no-default-features --prefix none --format '{p}' | cut -d' ' -f1 | sort -u)
+found=""
+for crate in $shells; do
+    if grep -qx "$crate" <<<"$tree"; then found+=" $crate"; fi
+done
+if [ -n "$found" ]; then
+    echo "FAILED: the core library depends on:$found" >&2
+    exit 1
+fi
+echo "ok: none of $shells"
