@@ -587,37 +587,4 @@ fn round_up(t: f64) -> f32 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::round_up;
-
-    #[test]
-    fn round_up_is_the_least_f32_not_below() {
-        let mut values = vec![
-            0.0,
-            -0.0,
-            1e-300,
-            f64::from(f32::MAX),
-            f64::from(f32::MAX) * (1.0 + 1e-12),
-            1e300,
-            f64::INFINITY,
-            f64::NAN,
-            f64::NEG_INFINITY,
-            -1e-300,
-            -1.5,
-            -f64::from(f32::MAX) * (1.0 + 1e-12),
-        ];
-        // Values between, on and beside f32s of every magnitude.
-        for e in -140..=127 {
-            let f = 2f64.powi(e) * 1.2345;
-            let f32_near = f64::from(f as f32);
-            values.extend([f, -f, f32_near, f32_near.next_up(), f32_near.next_down()]);
-        }
-        for t in values {
-            let up = round_up(t);
-            let f = t as f32;
-            let want = if f64::from(f) < t { f.next_up() } else { f };
-            assert_eq!(up.to_bits(), want.to_bits(), "t = {t:e}");
-            assert!(t.is_nan() || f64::from(up) >= t, "t = {t:e}");
-        }
-    }
-}
+mod tests;
