@@ -9,7 +9,7 @@
 //! implement it, and the tests measure the one against the other.
 #![forbid(unsafe_code)]
 
-pub mod accel;
+pub(crate) mod accel;
 pub mod bench;
 pub mod camera;
 pub mod image_io;

@@ -9,13 +9,13 @@ use wide::{f32x4, CmpGe, CmpLe};
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug)]
-pub struct Aabb {
-    pub min: Vec3,
-    pub max: Vec3,
+pub(super) struct Aabb {
+    pub(super) min: Vec3,
+    pub(super) max: Vec3,
 }
 
 impl Aabb {
-    pub const EMPTY: Aabb = Aabb {
+    pub(super) const EMPTY: Aabb = Aabb {
         min: Vec3::splat(f32::INFINITY),
         max: Vec3::splat(f32::NEG_INFINITY),
     };
@@ -36,19 +36,19 @@ impl Aabb {
 }
 
 #[derive(Clone, Copy, Debug)]
-pub struct Node {
-    pub bounds: Aabb,
+struct Node {
+    bounds: Aabb,
     /// Leaf: index of the first item; inner node: index of the right child.
-    pub index: u32,
+    index: u32,
     /// Items in a leaf; 0 for an inner node (its left child is the next node).
-    pub count: u32,
+    count: u32,
     /// Inner node: the split axis, for near-child-first traversal.
-    pub axis: u32,
+    axis: u32,
 }
 
 /// The tree as the queries use it: four children per node, their boxes side by side
 /// so that one SIMD test checks all four.
-pub struct Bvh {
+pub(super) struct Bvh {
     nodes: Vec<Node4>,
     /// Item indices in leaf order.
     items: Vec<u32>,
@@ -86,7 +86,7 @@ const STACK: usize = 320;
 
 impl Bvh {
     /// Builds over `boxes` (one per item): a binary binned-SAH tree, then collapsed.
-    pub fn build(boxes: &[Aabb]) -> Bvh {
+    pub(super) fn build(boxes: &[Aabb]) -> Bvh {
         let mut items: Vec<u32> = (0..boxes.len() as u32).collect();
         let centres: Vec<Vec3> = boxes.iter().map(Aabb::centre).collect();
         let mut binary = Vec::with_capacity(2 * boxes.len().max(1));
@@ -107,13 +107,13 @@ impl Bvh {
 
     /// The items in leaf order: `traverse` visits slots of this list, so that data
     /// the caller lays out in this order is read from consecutive addresses.
-    pub fn items(&self) -> &[u32] {
+    pub(super) fn items(&self) -> &[u32] {
         &self.items
     }
 
     /// Calls `visit(slot)` for every item (`items()[slot]`) whose box overlaps the box
     /// `[min, max]`.
-    pub fn overlapping(&self, min: Vec3, max: Vec3, mut visit: impl FnMut(u32)) {
+    pub(super) fn overlapping(&self, min: Vec3, max: Vec3, mut visit: impl FnMut(u32)) {
         if self.nodes.is_empty() {
             return;
         }
@@ -145,7 +145,7 @@ impl Bvh {
     /// `o + t·d` (`inv_d = 1/d`) meets within `[0, t_max]`, nearest boxes first; `visit`
     /// returns a lower `t_max` when it finds a hit.
     #[inline]
-    pub fn traverse(
+    pub(super) fn traverse(
         &self,
         o: Vec3,
         inv_d: Vec3,

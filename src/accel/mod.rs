@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use bvh::{Aabb, Bvh};
 use dirgrid::DirGrid;
-pub use point::{EyeGrid, EyeRun, PointGrid};
+pub(crate) use point::{EyeGrid, PointGrid};
 
 use crate::model::Side;
 use crate::scene::Sphere;
@@ -21,31 +21,31 @@ use crate::trace::intersect::roots;
 
 /// The closest hit of a ray.
 #[derive(Clone, Copy, Debug)]
-pub struct Hit {
-    pub sphere: u32,
+pub(crate) struct Hit {
+    pub(crate) sphere: u32,
     /// The hit point re-projected onto the sphere, in `f64`.
-    pub point: DVec3,
+    pub(crate) point: DVec3,
     /// Outward unit normal.
-    pub normal: DVec3,
+    pub(crate) normal: DVec3,
     /// Hit at the near root: the ray enters the sphere here.
-    pub entering: bool,
+    pub(crate) entering: bool,
 }
 
 /// A ray as the queries see it: origin (in `f64`: a spawn point keeps the precision of
 /// its re-projection onto its sphere), unit direction, and the sphere it was spawned on
 /// with the way it leaves it.
 #[derive(Clone, Copy, Debug)]
-pub struct Query {
-    pub origin: DVec3,
-    pub dir: Vec3,
-    pub from: Option<(u32, Side)>,
+pub(crate) struct Query {
+    pub(crate) origin: DVec3,
+    pub(crate) dir: Vec3,
+    pub(crate) from: Option<(u32, Side)>,
 }
 
 impl Query {
     /// Crossings of other spheres closer than this are lost in the rounding of the
     /// spawn point's coordinates and ignored.
     #[inline]
-    pub fn t_min(&self) -> f64 {
+    pub(crate) fn t_min(&self) -> f64 {
         match self.from {
             None => 0.0,
             Some(_) => 16.0 * f64::EPSILON * self.origin.abs().max_element(),
@@ -135,7 +135,7 @@ struct LeafSphere {
 }
 
 /// The spheres, for the fast tracer's queries.
-pub struct Spheres {
+pub(crate) struct Spheres {
     center: Vec<DVec3>,
     radius: Vec<f64>,
     /// `1/radius`, for the normals.
@@ -158,7 +158,7 @@ pub struct Spheres {
 
 impl Spheres {
     /// The spheres with a hierarchy for rays of any origin.
-    pub fn new(spheres: &[Sphere]) -> Self {
+    pub(crate) fn new(spheres: &[Sphere]) -> Self {
         let center: Vec<DVec3> = spheres.iter().map(|s| s.center).collect();
         let radius: Vec<f64> = spheres.iter().map(|s| s.radius).collect();
         let quick: Vec<Vec4> = center
@@ -232,8 +232,10 @@ impl Spheres {
     }
 
     /// Adds a directional grid around each light, so that shadow rays test only the
-    /// spheres seen in their direction from the light.
-    pub fn with_light_grids(mut self, lights: &[DVec3]) -> Self {
+    /// spheres seen in their direction from the light. The tests build the grids one
+    /// part at a time with it; the tracer builds all at once ([`Spheres::build_for_view`]).
+    #[cfg(test)]
+    pub(crate) fn with_light_grids(mut self, lights: &[DVec3]) -> Self {
         let list = self.centres_and_radii();
         let n = grid_resolution(list.len());
         self.lights = lights
@@ -246,7 +248,11 @@ impl Spheres {
     /// The spheres with their hierarchy and light grids, and the eye grid of a first
     /// camera, all built at once (they are independent: on two cores this halves the
     /// build of a large scene).
-    pub fn build_for_view(spheres: &[Sphere], lights: &[DVec3], eye: DVec3) -> (Spheres, EyeGrid) {
+    pub(crate) fn build_for_view(
+        spheres: &[Sphere],
+        lights: &[DVec3],
+        eye: DVec3,
+    ) -> (Spheres, EyeGrid) {
         let list: Vec<(DVec3, f64)> = spheres.iter().map(|s| (s.center, s.radius)).collect();
         let n = grid_resolution(list.len());
         let points: Vec<DVec3> = std::iter::once(eye).chain(lights.iter().copied()).collect();
@@ -284,17 +290,13 @@ impl Spheres {
 
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
     /// the only part of the structures that depends on the camera.
-    pub fn eye_grid(&self, eye: DVec3) -> EyeGrid {
+    pub(crate) fn eye_grid(&self, eye: DVec3) -> EyeGrid {
         let list = self.centres_and_radii();
         self.eye_point_grid(DirGrid::build(eye, &list, eye_resolution(list.len())))
     }
 
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.center.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.center.is_empty()
     }
 
     /// `false` when sphere `k` certainly has no crossing in `(0, t_max)` (cheap, `f32`
@@ -365,7 +367,7 @@ impl Spheres {
     }
 
     /// The closest hit of a ray of any origin.
-    pub fn closest(&self, q: &Query) -> Option<Hit> {
+    pub(crate) fn closest(&self, q: &Query) -> Option<Hit> {
         if let Some((s, Side::Inward)) = q.from {
             if let Some(hit) = self.closest_inside(s, q) {
                 return Some(hit);
@@ -443,7 +445,7 @@ impl Spheres {
     }
 
     /// The shadow factor along the segment of length `dist` (step 4 of the model).
-    pub fn shadow(&self, q: &Query, dist: f64) -> f32 {
+    pub(crate) fn shadow(&self, q: &Query, dist: f64) -> f32 {
         let ray = Ray::new(q);
         let mut factor = 1.0f32;
         self.bvh.traverse(
