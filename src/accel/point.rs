@@ -157,9 +157,8 @@ impl PointQuick {
     /// [`PointQuick::may_cross`] for a ray whose line may pass up to `offset` from the
     /// point (the sphere is widened by `offset`), bounding the crossings by the half
     /// chord rather than the radius: `bp² − min_bp2` is the widened sphere's squared
-    /// half chord plus the slack. (Shadow rays: with the radius, 77% of the spheres
-    /// that passed in many_100000 were not crossed by the segment, most of them lying
-    /// just beyond the hit point.)
+    /// half chord plus the slack. (Shadow rays: bounded by the radius, most spheres
+    /// that pass lie just beyond the hit point and are not crossed by the segment.)
     #[inline(always)]
     fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
         let bp = -self.f.dot(d);
