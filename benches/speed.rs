@@ -1,15 +1,17 @@
-//! Speed benchmarks (`cargo bench`): the intersection kernel, the acceleration build,
-//! whole frames of the peers' scenes, and the viewer's views and screen conversions.
-//! Compare runs of one sitting, as ratios.
+//! Speed benchmarks (`cargo bench`): the intersection kernel, the fast tracer's rays
+//! of one and two bounces, the fast tracer's build (hierarchy and grids), whole frames
+//! of the peers' scenes, and the viewer's views and screen conversions. Compare runs of
+//! one sitting, as ratios.
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{DVec3, Vec3};
-use whitted::accel::{Query, Spheres};
 use whitted::render::{render, RenderControl};
 use whitted::scene::{hw3_scene, many_scene, HW3_DEFAULT_SEED};
+use whitted::trace::fast::FastTracer;
 use whitted::trace::intersect::roots;
+use whitted::trace::{RayCounts, SampleTracer};
 
 /// Rays from the hw3 camera through a grid of film positions.
 fn hw3_rays(n: u32) -> Vec<Vec3> {
@@ -37,39 +39,32 @@ fn kernel(c: &mut Criterion) {
             black_box(hits)
         })
     });
-    let scene = hw3_scene(HW3_DEFAULT_SEED);
-    let spheres = Spheres::new(&scene.spheres);
-    c.bench_function("accel/closest_bvh_hw3_4096_rays", |b| {
-        b.iter(|| {
-            let mut hits = 0;
-            for &dir in &dirs {
-                let q = Query {
-                    origin: DVec3::ZERO,
-                    dir,
-                    from: None,
-                };
-                hits += spheres.closest(&q).is_some() as u32;
-            }
-            black_box(hits)
-        })
-    });
-    let lights = [scene.lights[0].position];
-    let gridded = Spheres::new(&scene.spheres).with_light_grids(&lights);
-    let eye = gridded.eye_grid(DVec3::ZERO);
-    c.bench_function("accel/closest_primary_grid_hw3_4096_rays", |b| {
-        b.iter(|| {
-            let mut hits = 0;
-            for &dir in &dirs {
-                let q = Query {
-                    origin: DVec3::ZERO,
-                    dir,
-                    from: None,
-                };
-                hits += gridded.closest_primary(&eye, &q).is_some() as u32;
-            }
-            black_box(hits)
-        })
-    });
+    // The fast tracer's samples of 64×64 film positions, with no light: at depth 1 a
+    // sample is its primary ray (the eye grid's query) and its shading; at depth 2 the
+    // reflected and transmitted rays (the hierarchy's query) are added.
+    let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+    scene.lights.clear();
+    let cam = scene.camera(1280, 720).expect("camera");
+    let n = 64;
+    let film: Vec<(f32, f32)> = (0..n * n)
+        .map(|k| ((k % n) as f32 / n as f32, (k / n) as f32 / n as f32))
+        .collect();
+    for (name, depth) in [
+        ("trace/primary_hw3_4096_rays", 1),
+        ("trace/one_bounce_hw3_4096_rays", 2),
+    ] {
+        let tracer = FastTracer::new(&scene, &cam, depth);
+        c.bench_function(name, |b| {
+            b.iter(|| {
+                let mut counts = RayCounts::default();
+                let mut sum = 0.0;
+                for &(s, t) in &film {
+                    sum += tracer.sample(s, t, &mut counts).x;
+                }
+                black_box((sum, counts))
+            })
+        });
+    }
 }
 
 fn build(c: &mut Criterion) {
@@ -78,12 +73,10 @@ fn build(c: &mut Criterion) {
     for n in [10_000, 100_000] {
         let scene = many_scene(n);
         let cam = scene.camera(1280, 720).expect("camera");
-        let lights: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
-        group.bench_function(format!("bvh_and_grids_many_{n}"), |b| {
-            b.iter(|| {
-                let spheres = Spheres::new(&scene.spheres).with_light_grids(&lights);
-                black_box(spheres.eye_grid(cam.origin))
-            })
+        let depth = scene.settings().quality.max_depth;
+        // The hierarchy, the lights' grids and the eye grid, with the materials.
+        group.bench_function(format!("tracer_many_{n}"), |b| {
+            b.iter(|| black_box(FastTracer::new(&scene, &cam, depth)))
         });
     }
     group.finish();

@@ -40,7 +40,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod accel;
+pub(crate) mod accel;
 // The shells' support (`whitted bench`, `whitted time`, the window): behind features,
 // not part of the library's API.
 #[cfg(feature = "cli")]

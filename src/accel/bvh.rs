@@ -9,13 +9,13 @@ use wide::{f32x4, CmpGe, CmpLe};
 
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug)]
-pub struct Aabb {
-    pub min: Vec3,
-    pub max: Vec3,
+pub(super) struct Aabb {
+    pub(super) min: Vec3,
+    pub(super) max: Vec3,
 }
 
 impl Aabb {
-    pub const EMPTY: Aabb = Aabb {
+    pub(super) const EMPTY: Aabb = Aabb {
         min: Vec3::splat(f32::INFINITY),
         max: Vec3::splat(f32::NEG_INFINITY),
     };
@@ -36,28 +36,26 @@ impl Aabb {
 }
 
 #[derive(Clone, Copy, Debug)]
-pub struct Node {
-    pub bounds: Aabb,
+struct Node {
+    bounds: Aabb,
     /// Leaf: index of the first item; inner node: index of the right child.
-    pub index: u32,
+    index: u32,
     /// Items in a leaf; 0 for an inner node (its left child is the next node).
-    pub count: u32,
+    count: u32,
     /// Inner node: the split axis, for near-child-first traversal.
-    pub axis: u32,
+    axis: u32,
 }
 
 /// The tree as the queries use it: four children per node, their boxes side by side
 /// so that one SIMD test checks all four.
-pub struct Bvh {
+pub(super) struct Bvh {
     nodes: Vec<Node4>,
     /// Item indices in leaf order.
     items: Vec<u32>,
 }
 
-/// A node of the 4-wide tree: child boxes as four lanes per coordinate. Two cache
-/// lines exactly (at 144 bytes with no alignment, most nodes spanned three): on
-/// many_100000 a quarter fewer of the hierarchy's reads miss the first-level cache
-/// (simulated), though its queries' time is set by their arithmetic.
+/// A node of the 4-wide tree: child boxes as four lanes per coordinate. Aligned to two
+/// cache lines exactly, so that reading a node touches two lines, never three.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node4 {
@@ -86,7 +84,7 @@ const STACK: usize = 320;
 
 impl Bvh {
     /// Builds over `boxes` (one per item): a binary binned-SAH tree, then collapsed.
-    pub fn build(boxes: &[Aabb]) -> Bvh {
+    pub(super) fn build(boxes: &[Aabb]) -> Bvh {
         let mut items: Vec<u32> = (0..boxes.len() as u32).collect();
         let centres: Vec<Vec3> = boxes.iter().map(Aabb::centre).collect();
         let mut binary = Vec::with_capacity(2 * boxes.len().max(1));
@@ -107,13 +105,13 @@ impl Bvh {
 
     /// The items in leaf order: `traverse` visits slots of this list, so that data
     /// the caller lays out in this order is read from consecutive addresses.
-    pub fn items(&self) -> &[u32] {
+    pub(super) fn items(&self) -> &[u32] {
         &self.items
     }
 
     /// Calls `visit(slot)` for every item (`items()[slot]`) whose box overlaps the box
     /// `[min, max]`.
-    pub fn overlapping(&self, min: Vec3, max: Vec3, mut visit: impl FnMut(u32)) {
+    pub(super) fn overlapping(&self, min: Vec3, max: Vec3, mut visit: impl FnMut(u32)) {
         if self.nodes.is_empty() {
             return;
         }
@@ -145,7 +143,7 @@ impl Bvh {
     /// `o + t·d` (`inv_d = 1/d`) meets within `[0, t_max]`, nearest boxes first; `visit`
     /// returns a lower `t_max` when it finds a hit.
     #[inline]
-    pub fn traverse(
+    pub(super) fn traverse(
         &self,
         o: Vec3,
         inv_d: Vec3,
@@ -167,7 +165,7 @@ impl Bvh {
         let o4 = [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)];
         let inv4 = inv.map(f32x4::splat);
         // Entries: (node, 0) or (first item, items) of a leaf, with the distance at
-        // which the ray enters its box. Not zeroed: a zeroed array cost more than the
+        // which the ray enters its box. Not zeroed: a zeroed array costs more than the
         // traversal of a short ray.
         let mut stack: ArrayVec<(u32, u32, f32), STACK> = ArrayVec::new();
         stack.push((0, 0, 0.0));
@@ -202,8 +200,8 @@ impl Bvh {
             let near = near.to_array();
             // Children onto the stack farthest first, leaves and inner nodes alike: the
             // nearest comes off first, so hits are found nearest first and prune the
-            // rest (visiting leaves at once found farther hits first, each a wasted
-            // exact test).
+            // rest (visiting leaves at once would find farther hits first, each a
+            // wasted exact test).
             let push = |stack: &mut ArrayVec<_, STACK>, lane: usize| {
                 stack.push((n.child[lane], u32::from(n.count[lane]), near[lane]));
             };

@@ -9,9 +9,9 @@
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-pub struct DirGrid {
+pub(super) struct DirGrid {
     /// The point every ray of the grid passes through.
-    pub centre: DVec3,
+    pub(super) centre: DVec3,
     /// Cells per face side.
     n: u32,
     /// `n/2`.
@@ -21,7 +21,7 @@ pub struct DirGrid {
     /// Per entry: the sphere, and its nearest distance from the centre rounded down.
     items: Vec<(u32, f32)>,
     /// Spheres that contain the centre: seen in every direction.
-    pub always: Vec<u32>,
+    pub(super) always: Vec<u32>,
 }
 
 /// Spheres a unit of parallel work of the build: enough to outweigh its overhead.
@@ -67,7 +67,7 @@ const WIDEN: f64 = 1e-4;
 
 impl DirGrid {
     /// Builds the grid around `centre` for spheres `(centre, radius)`.
-    pub fn build(centre: DVec3, spheres: &[(DVec3, f64)], n: u32) -> DirGrid {
+    pub(super) fn build(centre: DVec3, spheres: &[(DVec3, f64)], n: u32) -> DirGrid {
         let faces = 6 * (n as usize) * (n as usize);
         // Each sphere's nearest distance from the centre, rounded down so that the
         // early exit of queries stays conservative.
@@ -131,7 +131,7 @@ impl DirGrid {
 
     /// The cell of direction `d` (any length, not zero).
     #[inline]
-    pub fn cell(&self, d: Vec3) -> usize {
+    pub(super) fn cell(&self, d: Vec3) -> usize {
         let a = d.abs();
         let (face, major, u, v) = if a.x >= a.y && a.x >= a.z {
             (u32::from(d.x < 0.0), a.x, d.y, d.z)
@@ -149,7 +149,7 @@ impl DirGrid {
 
     /// The spheres of a cell with their nearest distances, nearest first.
     #[inline]
-    pub fn candidates(&self, cell: usize) -> &[(u32, f32)] {
+    pub(super) fn candidates(&self, cell: usize) -> &[(u32, f32)] {
         let (start, end) = (self.offsets[cell] as usize, self.offsets[cell + 1] as usize);
         &self.items[start..end]
     }

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use bvh::{Aabb, Bvh};
 use dirgrid::DirGrid;
-pub use point::{EyeGrid, EyeRun, PointGrid};
+pub(crate) use point::{EyeGrid, PointGrid};
 
 use crate::model::Side;
 use crate::scene::Sphere;
@@ -21,31 +21,31 @@ use crate::trace::intersect::roots;
 
 /// The closest hit of a ray.
 #[derive(Clone, Copy, Debug)]
-pub struct Hit {
-    pub sphere: u32,
+pub(crate) struct Hit {
+    pub(crate) sphere: u32,
     /// The hit point re-projected onto the sphere, in `f64`.
-    pub point: DVec3,
+    pub(crate) point: DVec3,
     /// Outward unit normal.
-    pub normal: DVec3,
+    pub(crate) normal: DVec3,
     /// Hit at the near root: the ray enters the sphere here.
-    pub entering: bool,
+    pub(crate) entering: bool,
 }
 
 /// A ray as the queries see it: origin (in `f64`: a spawn point keeps the precision of
 /// its re-projection onto its sphere), unit direction, and the sphere it was spawned on
 /// with the way it leaves it.
 #[derive(Clone, Copy, Debug)]
-pub struct Query {
-    pub origin: DVec3,
-    pub dir: Vec3,
-    pub from: Option<(u32, Side)>,
+pub(crate) struct Query {
+    pub(crate) origin: DVec3,
+    pub(crate) dir: Vec3,
+    pub(crate) from: Option<(u32, Side)>,
 }
 
 impl Query {
     /// Crossings of other spheres closer than this are lost in the rounding of the
     /// spawn point's coordinates and ignored.
     #[inline]
-    pub fn t_min(&self) -> f64 {
+    pub(crate) fn t_min(&self) -> f64 {
         match self.from {
             None => 0.0,
             Some(_) => 16.0 * f64::EPSILON * self.origin.abs().max_element(),
@@ -78,17 +78,11 @@ impl Ray {
 /// never rejects a sphere the exact `f64` test would hit.
 const QUICK_SLACK: f32 = 1.0 / (1 << 18) as f32;
 
-/// Cells per face of the eye's grid: coarser than the lights' below 16k spheres. Its
-/// empty cells let whole runs of sky pixels skip the query (larger cells, more such
-/// runs, and more runs of pixels in one cell sharing its lookup) while a primary ray's
-/// list stays short. Measured (1 thread, best of 21): hw3 (52 spheres) 0.056 s at
-/// 16–32 cells against 0.061 s at 128; many_1000 best at 32–64 (−4% against 128),
-/// many_10000 at 64 (−3%), many_100000 at 256 (128: +7%). Since the runs share their
-/// cell, instructions (callgrind) of hw3 at 8, 12, 16, 24 and 32 cells: 767.5, 763.1,
-/// 772.1, 778.4 and 795.4 million, and of 40 orbit views 21.32, 21.29, 21.37, – and
-/// 21.78 billion; many_1000 at 32, 48, 64 and 96: 1.029, 0.994, 0.995, 1.009 billion;
-/// many_100000 at 192, 256 and 384: 9.636, 9.648 and 9.708 billion, and 192 builds in
-/// 10% less time (0.072 against 0.081 s, medians of five sittings on two threads).
+/// Cells per face of the eye's grid: coarser than the lights' below 16k spheres. Larger
+/// cells leave more of them empty, so more runs of sky pixels skip the query, and put
+/// more runs of pixels in one cell to share its lookup; smaller cells keep a primary
+/// ray's list short. The steps grow with the scene, each at the fastest resolution
+/// measured for its size.
 fn eye_resolution(spheres: usize) -> u32 {
     match spheres {
         0..=64 => 12,
@@ -124,8 +118,8 @@ struct Exact {
 }
 
 /// A sphere in the hierarchy's leaf order: all that a query through the hierarchy
-/// reads of it, side by side (in a large scene, three more arrays read in the scene's
-/// order were three more cache misses an exact test).
+/// reads of it, side by side (in a large scene, each array read in the scene's order
+/// instead would be one more cache miss an exact test).
 #[derive(Clone, Copy)]
 struct LeafSphere {
     exact: Exact,
@@ -135,7 +129,7 @@ struct LeafSphere {
 }
 
 /// The spheres, for the fast tracer's queries.
-pub struct Spheres {
+pub(crate) struct Spheres {
     center: Vec<DVec3>,
     radius: Vec<f64>,
     /// `1/radius`, for the normals.
@@ -158,7 +152,7 @@ pub struct Spheres {
 
 impl Spheres {
     /// The spheres with a hierarchy for rays of any origin.
-    pub fn new(spheres: &[Sphere]) -> Self {
+    pub(crate) fn new(spheres: &[Sphere]) -> Self {
         let center: Vec<DVec3> = spheres.iter().map(|s| s.center).collect();
         let radius: Vec<f64> = spheres.iter().map(|s| s.radius).collect();
         let quick: Vec<Vec4> = center
@@ -232,8 +226,10 @@ impl Spheres {
     }
 
     /// Adds a directional grid around each light, so that shadow rays test only the
-    /// spheres seen in their direction from the light.
-    pub fn with_light_grids(mut self, lights: &[DVec3]) -> Self {
+    /// spheres seen in their direction from the light. The tests build the grids one
+    /// part at a time with it; the tracer builds all at once ([`Spheres::build_for_view`]).
+    #[cfg(test)]
+    pub(crate) fn with_light_grids(mut self, lights: &[DVec3]) -> Self {
         let list = self.centres_and_radii();
         let n = grid_resolution(list.len());
         self.lights = lights
@@ -244,9 +240,12 @@ impl Spheres {
     }
 
     /// The spheres with their hierarchy and light grids, and the eye grid of a first
-    /// camera, all built at once (they are independent: on two cores this halves the
-    /// build of a large scene).
-    pub fn build_for_view(spheres: &[Sphere], lights: &[DVec3], eye: DVec3) -> (Spheres, EyeGrid) {
+    /// camera, built side by side on the pool's threads (they are independent).
+    pub(crate) fn build_for_view(
+        spheres: &[Sphere],
+        lights: &[DVec3],
+        eye: DVec3,
+    ) -> (Spheres, EyeGrid) {
         let list: Vec<(DVec3, f64)> = spheres.iter().map(|s| (s.center, s.radius)).collect();
         let n = grid_resolution(list.len());
         let points: Vec<DVec3> = std::iter::once(eye).chain(lights.iter().copied()).collect();
@@ -284,17 +283,13 @@ impl Spheres {
 
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
     /// the only part of the structures that depends on the camera.
-    pub fn eye_grid(&self, eye: DVec3) -> EyeGrid {
+    pub(crate) fn eye_grid(&self, eye: DVec3) -> EyeGrid {
         let list = self.centres_and_radii();
         self.eye_point_grid(DirGrid::build(eye, &list, eye_resolution(list.len())))
     }
 
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.center.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.center.is_empty()
     }
 
     /// `false` when sphere `k` certainly has no crossing in `(0, t_max)` (cheap, `f32`
@@ -310,7 +305,7 @@ impl Spheres {
     fn crossing(&self, k: usize, ray: &Ray, t_max: f64) -> Option<(f64, bool, DVec3)> {
         // Renormalised here, for the few spheres that pass the quick test (shadow rays
         // mostly have none). Not inlined: inlined into the shadow loops, the
-        // normalisation was hoisted out of them, onto every shadow ray.
+        // normalisation would be hoisted out of them, onto every shadow ray.
         self.crossing_along(k, ray, unit64(ray.d32), t_max)
     }
 
@@ -365,7 +360,7 @@ impl Spheres {
     }
 
     /// The closest hit of a ray of any origin.
-    pub fn closest(&self, q: &Query) -> Option<Hit> {
+    pub(crate) fn closest(&self, q: &Query) -> Option<Hit> {
         if let Some((s, Side::Inward)) = q.from {
             if let Some(hit) = self.closest_inside(s, q) {
                 return Some(hit);
@@ -443,7 +438,7 @@ impl Spheres {
     }
 
     /// The shadow factor along the segment of length `dist` (step 4 of the model).
-    pub fn shadow(&self, q: &Query, dist: f64) -> f32 {
+    pub(crate) fn shadow(&self, q: &Query, dist: f64) -> f32 {
         let ray = Ray::new(q);
         let mut factor = 1.0f32;
         self.bvh.traverse(
@@ -519,16 +514,17 @@ fn may_cross(c: DVec3, w: f32, ray: &Ray, t_max: f32) -> bool {
     // it errs from the true one by at most 13u·|f| (u = 2⁻²⁴: f's rounding u|f|, the
     // direction's length off 1 by up to 3.5u, the products' and sums' rounding), and
     // l·l by 3u relative more. So the sphere is widened by 32u·|f| and its square by 8u,
-    // with room to spare. (A slack relative to |f|² let a ball of r = 0.1 at 100 pass
-    // when the line was within 0.22 of its centre.)
+    // with room to spare: a slack on |l| relative to |f|, not on l·l relative to |f|²,
+    // which would let far small balls pass for lines well outside them.
     let widened = w + LINE_SLACK * fl;
     let rr = widened * widened * (1.0 + 8.0 * U32);
     // The crossings lie in [bp − h, bp + h] with h the half chord, up to rounding;
     // `rr` keeps this h above the true one, and the tail covers the rounding of bp.
-    // (With h = r, a ray leaving a huge sphere's outside — up from the ground — passed
-    // and cost an exact test.) A line that passes too far gives h = NaN, which fails
-    // every comparison; `&`, not `&&`: one branch on the outcome (an early return on the
-    // first test was mispredicted often enough to cost more than the square roots).
+    // (Bounded by r instead of h, a ray leaving a huge sphere's outside — up from the
+    // ground — would pass and cost an exact test.) A line that passes too far gives
+    // h = NaN, which fails every comparison; `&`, not `&&`: one branch on the outcome
+    // (an early return on the first test is mispredicted often enough to cost more
+    // than the square roots).
     let reach = (rr - ll).sqrt() + QUICK_SLACK * (fl + w);
     (ll <= rr) & (bp + reach > 0.0) & (bp - reach < t_max)
 }
@@ -577,7 +573,7 @@ fn round_up(t: f64) -> f32 {
     if t >= 0.0 {
         // The queries' distances: one step up is one more in the bits (of +0 the least
         // subnormal, of f32::MAX infinity), added without a branch: whether the cast
-        // rounded down is a coin toss, and a mispredicted branch cost more than this.
+        // rounded down is a coin toss, and a mispredicted branch costs more than this.
         f32::from_bits(f.to_bits() + u32::from(f64::from(f) < t))
     } else if f64::from(f) < t {
         f.next_up()
@@ -587,37 +583,4 @@ fn round_up(t: f64) -> f32 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::round_up;
-
-    #[test]
-    fn round_up_is_the_least_f32_not_below() {
-        let mut values = vec![
-            0.0,
-            -0.0,
-            1e-300,
-            f64::from(f32::MAX),
-            f64::from(f32::MAX) * (1.0 + 1e-12),
-            1e300,
-            f64::INFINITY,
-            f64::NAN,
-            f64::NEG_INFINITY,
-            -1e-300,
-            -1.5,
-            -f64::from(f32::MAX) * (1.0 + 1e-12),
-        ];
-        // Values between, on and beside f32s of every magnitude.
-        for e in -140..=127 {
-            let f = 2f64.powi(e) * 1.2345;
-            let f32_near = f64::from(f as f32);
-            values.extend([f, -f, f32_near, f32_near.next_up(), f32_near.next_down()]);
-        }
-        for t in values {
-            let up = round_up(t);
-            let f = t as f32;
-            let want = if f64::from(f) < t { f.next_up() } else { f };
-            assert_eq!(up.to_bits(), want.to_bits(), "t = {t:e}");
-            assert!(t.is_nan() || f64::from(up) >= t, "t = {t:e}");
-        }
-    }
-}
+mod tests;

@@ -13,7 +13,7 @@ use crate::trace::intersect::roots_from;
 /// A directional grid around a point (the camera origin or a light), with what the
 /// quick test of a ray through that point needs of each sphere worked out once: only
 /// the direction varies between such rays.
-pub struct PointGrid {
+pub(crate) struct PointGrid {
     grid: DirGrid,
     quick: Vec<PointQuick>,
     /// Around the eye only: per sphere, all that a primary ray's tests read of it.
@@ -67,7 +67,7 @@ impl<'a> EyeStart<'a> {
 /// row between two that fall in one cell (see [`Spheres::eye_run`]): one cell lookup
 /// serves them all.
 #[derive(Clone, Copy)]
-pub struct EyeRun<'a> {
+pub(crate) struct EyeRun<'a> {
     /// The cell's spheres, nearest first.
     candidates: &'a [(u32, f32)],
 }
@@ -82,7 +82,7 @@ impl<'a> EyeRun<'a> {
 
     /// No direction of the run meets a sphere: they all see the sky.
     #[inline]
-    pub fn sees_nothing(&self) -> bool {
+    pub(crate) fn sees_nothing(&self) -> bool {
         self.candidates.is_empty()
     }
 }
@@ -99,7 +99,7 @@ struct EyeSphere {
 }
 
 /// The grid around a camera origin (see [`Spheres::eye_grid`]).
-pub type EyeGrid = PointGrid;
+pub(crate) type EyeGrid = PointGrid;
 
 /// One sphere as the quick test of rays through a grid's point sees it (see
 /// [`PointQuick::may_cross`]).
@@ -157,9 +157,8 @@ impl PointQuick {
     /// [`PointQuick::may_cross`] for a ray whose line may pass up to `offset` from the
     /// point (the sphere is widened by `offset`), bounding the crossings by the half
     /// chord rather than the radius: `bp² − min_bp2` is the widened sphere's squared
-    /// half chord plus the slack. (Shadow rays: with the radius, 77% of the spheres
-    /// that passed in many_100000 were not crossed by the segment, most of them lying
-    /// just beyond the hit point.)
+    /// half chord plus the slack. (Shadow rays: bounded by the radius, most spheres
+    /// that pass lie just beyond the hit point and are not crossed by the segment.)
     #[inline(always)]
     fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
         let bp = -self.f.dot(d);
@@ -210,7 +209,7 @@ impl Spheres {
     }
 
     /// The closest hit of a primary ray: a ray from the centre of `eye`.
-    pub fn closest_primary(&self, eye: &EyeGrid, q: &Query) -> Option<Hit> {
+    pub(crate) fn closest_primary(&self, eye: &EyeGrid, q: &Query) -> Option<Hit> {
         let grid = &eye.grid;
         if grid.centre != q.origin || q.from.is_some() {
             return self.closest(q);
@@ -236,7 +235,7 @@ impl Spheres {
 
     /// [`Spheres::closest_primary`] for the ray from the eye with unit direction `d`,
     /// with the origin's part of every test worked out beforehand (same results).
-    pub fn closest_from_eye(&self, eye: &EyeGrid, d: Vec3) -> Option<Hit> {
+    pub(crate) fn closest_from_eye(&self, eye: &EyeGrid, d: Vec3) -> Option<Hit> {
         if !eye.eye_shortcut_applies(self.len()) {
             return self.closest_primary(eye, &eye.query(d));
         }
@@ -247,7 +246,12 @@ impl Spheres {
     /// [`Spheres::closest_from_eye`] of two rays at once: each ray's answer is a chain
     /// of long-latency steps (square roots, divisions, dependent loads); set side by
     /// side, the processor overlaps the two chains.
-    pub fn closest_from_eye_pair(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> [Option<Hit>; 2] {
+    pub(crate) fn closest_from_eye_pair(
+        &self,
+        eye: &EyeGrid,
+        a: Vec3,
+        b: Vec3,
+    ) -> [Option<Hit>; 2] {
         if !eye.eye_shortcut_applies(self.len()) {
             return [
                 self.closest_primary(eye, &eye.query(a)),
@@ -263,7 +267,7 @@ impl Spheres {
 
     /// [`Spheres::closest_from_eye_pair`] of two directions of `run` (from
     /// [`Spheres::eye_run`] of this grid): the same hits, without a cell lookup each.
-    pub fn closest_in_run_pair(
+    pub(crate) fn closest_in_run_pair(
         &self,
         eye: &EyeGrid,
         run: &EyeRun<'_>,
@@ -285,7 +289,7 @@ impl Spheres {
     /// sphere seen within a widened cone, which covers the rounding of the directions
     /// many times over) and the eye is inside no sphere.
     #[inline]
-    pub fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
+    pub(crate) fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
         let grid = &eye.grid;
         let cell = grid.cell(a);
         let shortcut = eye.eye_shortcut_applies(self.len());
@@ -331,14 +335,16 @@ impl Spheres {
     }
 
     /// `true` when no ray from the eye with a direction between `a` and `b` can meet a
-    /// sphere: their [`Spheres::eye_run`] is an empty cell.
-    pub fn eye_sees_nothing_between(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> bool {
+    /// sphere: their [`Spheres::eye_run`] is an empty cell. (The tracer asks the run
+    /// itself, [`EyeRun::sees_nothing`]; the tests ask this.)
+    #[cfg(test)]
+    pub(crate) fn eye_sees_nothing_between(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> bool {
         self.eye_run(eye, a, b)
             .is_some_and(|run| run.sees_nothing())
     }
 
     /// The shadow factor along the segment of length `dist` towards light `light`.
-    pub fn shadow_to_light(&self, q: &Query, dist: f64, light: usize) -> f32 {
+    pub(crate) fn shadow_to_light(&self, q: &Query, dist: f64, light: usize) -> f32 {
         let Some(lg) = self.lights.get(light) else {
             return self.shadow(q, dist);
         };
@@ -348,7 +354,7 @@ impl Spheres {
 
     /// [`Spheres::shadow_to_light`] of two segments at once (see
     /// [`Spheres::closest_from_eye_pair`]).
-    pub fn shadow_to_light_pair(
+    pub(crate) fn shadow_to_light_pair(
         &self,
         a: (&Query, f64),
         b: (&Query, f64),

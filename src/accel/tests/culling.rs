@@ -1,21 +1,18 @@
-//! Issue 4 at scale: the fast path's culling (f32 boxes of the BVH, widened f32 sphere
-//! tests, the directional grids around the eye and the lights) must never lose a hit
-//! or an occluder of spheres from radius 1e-3 to 1e5 scattered up to 1e4 from the
+//! The culling of the fast path (the `f32` boxes of the hierarchy, the widened `f32`
+//! sphere tests, the directional grids around the eye and the lights) never loses a
+//! hit or an occluder, for spheres from radius 1e-3 to 1e5 scattered up to 1e4 from the
 //! origin. Every answer is compared with a brute-force `f64` test of every sphere;
 //! cases that are ambiguous at `f64` precision (near-tangent rays, near-ties, crossings
 //! at the ends of a shadow segment) are left out and counted.
-
-mod robust_support;
 
 use std::cell::RefCell;
 
 use glam::DVec3;
 use proptest::prelude::*;
-use robust_support::cases::runner;
-use robust_support::*;
-use whitted::accel::{Hit, Query, Spheres};
-use whitted::model::Side;
-use whitted::scene::Sphere;
+
+use super::*;
+use crate::accel::{Hit, Spheres};
+use crate::scene::Sphere;
 
 /// Random spheres: radius 10^U(−3,3), centre 10^U(−1,4) from the origin.
 fn world() -> impl Strategy<Value = Vec<Sphere>> {
@@ -301,7 +298,7 @@ fn rows_in_one_cell_get_the_per_ray_hits() {
                         let shared = set.closest_in_run_pair(&grid, &run, a, b);
                         for (d, got) in [(a, shared[0]), (b, shared[1])] {
                             let alone = set.closest_from_eye(&grid, d);
-                            let key = |h: Option<whitted::accel::Hit>| {
+                            let key = |h: Option<Hit>| {
                                 h.map(|h| (h.sphere, h.point, h.normal, h.entering))
                             };
                             prop_assert_eq!(key(got), key(alone));
@@ -401,7 +398,7 @@ fn rays_inside_a_sphere_meet_what_brute_force_meets() {
 /// `f64` (ambiguous cases left out and counted, as above).
 #[test]
 fn large_scenes_lose_no_hit_or_occluder() {
-    let scene = whitted::scene::many_scene(20_000);
+    let scene = crate::scene::many_scene(20_000);
     let spheres = &scene.spheres;
     let light = scene.lights[0].position;
     let eye = DVec3::new(0.0, 18.0, 60.0);

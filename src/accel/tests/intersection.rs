@@ -1,5 +1,10 @@
-//! The random cases of the intersection tests of `robust_intersect.rs`, measured against
-//! two truths: the query's own rounded ray, and the unrounded ray.
+//! Intersection and spawned rays through the fast path's queries ([`Spheres::closest`]
+//! and [`Spheres::shadow`] with a [`Query`]), against an independent `f64` computation
+//! ([`roots64`]).
+//!
+//! Two truths: the query's own ray (its direction rounded to `f32`, promoted), which
+//! measures the intersection maths and the spawn logic alone, and the unrounded `f64`
+//! ray, which adds the rounding of the direction (what a user sees).
 
 use std::cell::RefCell;
 
@@ -7,16 +12,15 @@ use std::ops::Sub;
 
 use glam::DVec3;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
-use whitted::accel::Spheres;
-use whitted::model::{self, Side};
-use whitted::scene::Sphere;
 
 use super::*;
+use crate::accel::Spheres;
+use crate::model;
+use crate::scene::Sphere;
 
 /// What the fast path's answer is compared with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Truth {
+enum Truth {
     /// The ray the query holds (its `f32` direction promoted), computed in `f64`: the
     /// error of the intersection maths alone.
     QueryRay,
@@ -24,46 +28,17 @@ pub enum Truth {
     Unrounded,
 }
 
-pub fn runner(cases: u32) -> TestRunner {
-    TestRunner::new_with_rng(
-        Config {
-            cases,
-            failure_persistence: None,
-            ..Config::default()
-        },
-        TestRng::deterministic_rng(RngAlgorithm::ChaCha),
-    )
-}
-
-/// A sphere of radius 10^U(−3,5) with its centre 10^U(−2,4) from the origin, an eye
-/// r·10^U(0.01,3) from the centre, and a point of the ball to aim at.
-pub fn sphere_and_eye() -> impl Strategy<Value = (DVec3, f64, DVec3, DVec3)> {
-    (
-        log_uniform(-3.0, 5.0),
-        log_uniform(-2.0, 4.0),
-        unit_vector(),
-        log_uniform(0.01, 3.0),
-        unit_vector(),
-        unit_vector(),
-        0.0f64..0.9,
-    )
-        .prop_map(|(r, dist_c, dir_c, eye_k, dir_eye, dir_aim, aim_k)| {
-            let c = dir_c * dist_c;
-            (c, r, c + dir_eye * (r * eye_k), c + dir_aim * (r * aim_k))
-        })
-}
-
 #[derive(Default, Debug)]
-pub struct ReHits {
-    pub spheres: u64,
-    pub primary_misses: u64,
-    pub outward: u64,
-    pub outward_rehits: u64,
-    pub shadow: u64,
-    pub shadowed: u64,
-    pub inward: u64,
-    pub inward_misses: u64,
-    pub max_rel_t: f64,
+struct ReHits {
+    spheres: u64,
+    primary_misses: u64,
+    outward: u64,
+    outward_rehits: u64,
+    shadow: u64,
+    shadowed: u64,
+    inward: u64,
+    inward_misses: u64,
+    max_rel_t: f64,
 }
 
 /// pbrt's TestReintersectConvex for spheres, through the fast path: `spheres` random
@@ -73,7 +48,7 @@ pub struct ReHits {
 /// not be shadowed by it, and 32 inward rays must find the far exit with t within 1e-5
 /// (relative) of the `f64` value; 0 misses. Returns the figures, or the first failure
 /// (shrunk by proptest) with the figures so far.
-pub fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
+fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
     let stats = RefCell::new(ReHits::default());
     let spawn = prop::collection::vec((unit_vector(), log_uniform(-3.0, 3.0)), 32);
     let result = runner(spheres).run(&(sphere_and_eye(), spawn), |((c, r, eye, aim), dirs)| {
@@ -170,7 +145,7 @@ pub fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
 
 /// Hit or miss, fast path against `f64`: rays from an eye near the origin aimed within
 /// 2r of a ball `dist` away. Returns (rays, wrong).
-pub fn hit_miss(truth: Truth, r: f64, dist: f64, rays: u32) -> (u64, u64) {
+fn hit_miss(truth: Truth, r: f64, dist: f64, rays: u32) -> (u64, u64) {
     let counts = RefCell::new((0u64, 0u64));
     let case = (
         log_uniform(-2.0, 1.0),
@@ -210,7 +185,7 @@ pub fn hit_miss(truth: Truth, r: f64, dist: f64, rays: u32) -> (u64, u64) {
 /// A ground of `radius` seen from 0.5 above its top, at depressions from just past the
 /// horizon to 0.1 rad beyond it, eyes within 10 of the top: the relative error of the
 /// hit's t. Returns (rays, median, max).
-pub fn ground_grazing(truth: Truth, radius: f64) -> (u64, f64, f64) {
+fn ground_grazing(truth: Truth, radius: f64) -> (u64, f64, f64) {
     let h = 0.5;
     let c = DVec3::new(0.0, -h - radius, 0.0);
     let horizon = (2.0 * h / radius).sqrt();
@@ -258,66 +233,41 @@ pub fn ground_grazing(truth: Truth, radius: f64) -> (u64, f64, f64) {
     (n, median, max)
 }
 
-/// An index of refraction 1 + 10^U(−3, 0.2) (1.001 to 2.58).
-pub fn ior() -> impl Strategy<Value = f64> {
-    log_uniform(-3.0, 0.2).prop_map(|x| 1.0 + x)
+#[test]
+fn spawned_rays_never_rehit_their_sphere_and_always_find_the_exit() {
+    for truth in [Truth::QueryRay, Truth::Unrounded] {
+        let s = reintersection(truth, 1000).unwrap_or_else(|e| panic!("{e}"));
+        assert!(s.spheres >= 1000);
+        assert!(
+            s.spheres - s.primary_misses >= 990,
+            "too few hits to spawn from: {s:?}"
+        );
+        assert_eq!((s.outward_rehits, s.shadowed, s.inward_misses), (0, 0, 0));
+    }
 }
 
-/// sin of the angle between two vectors, in `f64`.
-pub fn sin_between(a: DVec3, b: DVec3) -> f64 {
-    a.cross(b).length() / (a.length() * b.length())
-}
-
-/// Entry/exit symmetry through the fast queries: a ray refracted into a ball leaves it
-/// at the angle it came in at (the chord makes equal angles with both normals):
-/// |sin θ_out − sin θ_in| ≤ 1e-5. Balls of radius 10^U(−3,5) with |centre| up to 1e4,
-/// those with |centre| > `max_centre_over_radius`·r left out. Returns (max error, balls).
-pub fn refraction_symmetry(max_centre_over_radius: f64) -> Result<(f64, u64), String> {
-    let worst = RefCell::new((0.0f64, 0u64));
-    let result = runner(5_000)
-        .run(&(sphere_and_eye(), ior()), |((c, r, eye, aim), ior)| {
-            if c.length() > max_centre_over_radius * r {
-                return Ok(());
-            }
-            let set = Spheres::new(&[Sphere::new(c, r)]);
-            let primary = query(eye, aim - eye, None);
-            let Some(hit) = set.closest(&primary) else {
-                return Ok(());
-            };
-            let d = primary.dir;
-            let (inside, crosses) = model::transmit(d, hit.normal.as_vec3(), true, ior as f32);
-            if !crosses {
-                // Rounding can make k < 0 at grazing entry; then it reflects (tested below).
-                return Ok(());
-            }
-            let q = query(hit.point, inside.as_dvec3(), Some((0, Side::Inward)));
-            let exit = set.closest(&q);
-            prop_assert!(exit.is_some(), "the refracted ray must find the exit");
-            let exit = exit.unwrap();
-            prop_assert!(!exit.entering);
-            let (out, crosses) = model::transmit(q.dir, exit.normal.as_vec3(), false, ior as f32);
-            prop_assert!(out.is_finite());
-            prop_assert!(
-                crosses,
-                "a chord's exit angle equals its entry angle: no TIR"
-            );
-            let sin_in = sin_between(d.as_dvec3(), hit.normal);
-            let sin_out = sin_between(out.as_dvec3(), exit.normal);
-            let err = (sin_out - sin_in).abs();
-            let mut w = worst.borrow_mut();
-            w.0 = w.0.max(err);
-            w.1 += 1;
-            prop_assert!(
-                err <= 1e-5,
-                "r {r:e} |c| {:e}: sin in {sin_in} out {sin_out}",
-                c.length()
-            );
-            Ok(())
-        })
-        .map_err(|e| e.to_string());
-    let (err, n) = worst.into_inner();
-    println!(
-        "entry/exit symmetry (|c| ≤ {max_centre_over_radius:e} r): {n} balls, max |sin θout − sin θin| {err:.2e}"
+#[test]
+fn hit_or_miss_matches_f64_for_small_far_balls() {
+    let (_, wrong) = hit_miss(Truth::QueryRay, 0.01, 100.0, 20_000);
+    assert_eq!(wrong, 0, "r = 0.01 at distance 100");
+    let (n, wrong) = hit_miss(Truth::QueryRay, 1e-3, 1e3, 20_000);
+    assert!(wrong as f64 <= 0.02 * n as f64, "r = 1e-3 at distance 1e3");
+    // Against the unrounded ray the f32 direction's resolution shows (printed figures).
+    let (n, wrong) = hit_miss(Truth::Unrounded, 1e-3, 1e3, 20_000);
+    assert!(
+        wrong as f64 <= 0.02 * n as f64,
+        "unrounded, r = 1e-3 at distance 1e3"
     );
-    result.map(|()| (err, n))
+    hit_miss(Truth::Unrounded, 0.01, 100.0, 20_000);
+}
+
+/// The ground of radius 1e5 (and 1e6) at grazing angles: relative error of t ≤ 1e-6
+/// against `f64` on the query's ray; the unrounded ray's figures are printed.
+#[test]
+fn huge_ground_at_grazing_angles_keeps_t() {
+    for radius in [1e5, 1e6] {
+        let (_, _, max) = ground_grazing(Truth::QueryRay, radius);
+        assert!(max <= 1e-6, "r {radius:e}: max relative error {max:e}");
+        ground_grazing(Truth::Unrounded, radius);
+    }
 }

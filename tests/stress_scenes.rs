@@ -1,12 +1,12 @@
-//! Issue 4, the stress scenes: the files load, say what they stress and hold what the
-//! generator in `robust_support` builds; the fast tracer matches the f64 reference on
-//! every one of them; moving or scaling hw3 does not change its image.
+//! The stress scenes (`assets/scenes/stress/`): the files load, say what they stress
+//! and hold what the generator in `support` builds; the fast tracer matches the f64
+//! reference on every one of them; moving or scaling hw3 does not change its image.
 //!
-//! `WHITTED_WRITE_STRESS=1 cargo test --release --test robust_scenes` rewrites the files.
+//! `WHITTED_WRITE_STRESS=1 cargo test --release --test stress_scenes` rewrites the files.
 
-mod robust_support;
+mod support;
 
-use robust_support::*;
+use support::*;
 use whitted::scene::Scene;
 use whitted::settings::Precision;
 
