@@ -8,7 +8,9 @@
 # Both print the median of RUNS runs as render_s and the best as best_s.
 #
 # Environment: OUT (run.sh's output folder, default /tmp/peers-out), MANY (default
-# "1000 10000 100000"), RUNS (default 7), THREADS (default "1 2").
+# "1000 10000 100000"), RUNS (default 7), THREADS (default "1 2"), WHITTED (the binary
+# to time, default: target/release/whitted, built first; another binary, such as the
+# one before a change, is timed as it is).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${OUT:-/tmp/peers-out}
@@ -22,7 +24,10 @@ mkdir -p "$SCN"
 for n in $MANY; do
     [ -s "$SCN/many_$n.toml" ] || python3 "$PEERS/make_hw3.py" --many "$n" --outdir "$SCN" --toml >/dev/null
 done
-cargo build --release --quiet
+if [ -z "${WHITTED:-}" ]; then
+    cargo build --release --quiet
+    WHITTED=./target/release/whitted
+fi
 EMBREE=$(ls "$OUT"/bin/embree_rays.* 2>/dev/null | tail -1 || true)
 for scene in hw3 $(for n in $MANY; do echo "many_$n"; done); do
     for t in $THREADS; do
@@ -40,6 +45,6 @@ for scene in hw3 $(for n in $MANY; do echo "many_$n"; done); do
             median=$(sed -n "$(( (RUNS + 1) / 2 ))p" <<<"$sorted" | cut -d' ' -f2-)
             echo "$median best_s=$best runs=$RUNS"
         fi
-        ./target/release/whitted time "$SCN/$scene.toml" --runs "$RUNS" --threads "$t"
+        "$WHITTED" time "$SCN/$scene.toml" --runs "$RUNS" --threads "$t"
     done
 done

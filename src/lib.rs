@@ -62,6 +62,11 @@ pub mod trace;
 #[doc(hidden)]
 pub mod viewer;
 
+// README's examples run as doc tests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+
 pub use camera::{Camera, CameraSpec};
 pub use render::{render, Frame, RenderControl, RenderError, RenderStats};
 pub use scene::{Scene, SceneError};

@@ -1,4 +1,4 @@
-//! The fast `f32` tracer against the `f64` reference on the built-in scene (issue 2):
+//! The fast `f32` tracer against the `f64` reference on the built-in scene:
 //! at 640×360, at most 0.01% of the pixels may differ by more than one 8-bit level, and
 //! none by more than 8 except a handful on silhouettes (where an `f32` ray may pass on
 //! the other side of an edge than the `f64` one).

@@ -2,11 +2,11 @@
 //! value with the line and column of the offending key. Nothing here panics on input.
 //!
 //! Memory: `toml` builds a tree of the whole document before `serde` sees it, about 35
-//! to 65 times the size of the text (measured: 483 MB for the 13.5 MB many_100000
-//! scene, 2.3 GB for a million minimal spheres). So the common layout of big scenes,
-//! the settings first and then a run of `[[sphere]]` tables to the end of the file, is
-//! parsed in batches of tables, in parallel ([`SphereRun`]; many_100000: 24 MB peak,
-//! 0.46 s instead of 0.9 s), and every other layout only up to
+//! to 65 times the size of the text (483 MB for the 13.5 MB many_100000 scene, 2.3 GB
+//! for a million minimal spheres). So the common layout of big scenes, the settings
+//! first and then a run of `[[sphere]]` tables to the end of the file, is parsed in
+//! batches of tables, in parallel ([`SphereRun`]: many_100000 peaks at 24 MB), and
+//! every other layout only up to
 //! [`limits::MAX_WHOLE_PARSE_BYTES`]. The sphere count is known from a scan of the
 //! lines before anything is parsed, so a file with too many spheres is refused first.
 //!
