@@ -246,6 +246,10 @@ impl Spheres {
     /// [`Spheres::closest_from_eye`] of two rays at once: each ray's answer is a chain
     /// of long-latency steps (square roots, divisions, dependent loads); set side by
     /// side, the processor overlaps the two chains.
+    // Out of line, as each of the ray-pair queries: inlined into the row loop of
+    // `FastTracer::sample_row` they leave the instruction count as it is but make hw3's
+    // render about 7% slower (a larger loop body, worse register use).
+    #[inline(never)]
     pub(crate) fn closest_from_eye_pair(
         &self,
         eye: &EyeGrid,
@@ -267,6 +271,10 @@ impl Spheres {
 
     /// [`Spheres::closest_from_eye_pair`] of two directions of `run` (from
     /// [`Spheres::eye_run`] of this grid): the same hits, without a cell lookup each.
+    // Out of line, as each of the ray-pair queries: inlined into the row loop of
+    // `FastTracer::sample_row` they leave the instruction count as it is but make hw3's
+    // render about 7% slower (a larger loop body, worse register use).
+    #[inline(never)]
     pub(crate) fn closest_in_run_pair(
         &self,
         eye: &EyeGrid,
@@ -288,7 +296,7 @@ impl Spheres {
     /// directions between project to the segment between, inside it; cells list every
     /// sphere seen within a widened cone, which covers the rounding of the directions
     /// many times over) and the eye is inside no sphere.
-    #[inline]
+    #[inline(never)]
     pub(crate) fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
         let grid = &eye.grid;
         let cell = grid.cell(a);
@@ -354,6 +362,10 @@ impl Spheres {
 
     /// [`Spheres::shadow_to_light`] of two segments at once (see
     /// [`Spheres::closest_from_eye_pair`]).
+    // Out of line, as each of the ray-pair queries: inlined into the row loop of
+    // `FastTracer::sample_row` they leave the instruction count as it is but make hw3's
+    // render about 7% slower (a larger loop body, worse register use).
+    #[inline(never)]
     pub(crate) fn shadow_to_light_pair(
         &self,
         a: (&Query, f64),
