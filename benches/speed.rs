@@ -7,10 +7,10 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{DVec3, Vec3};
+use whitted::intersect::roots;
 use whitted::render::{render, RenderControl};
 use whitted::scene::{hw3_scene, many_scene, HW3_DEFAULT_SEED};
 use whitted::trace::fast::FastTracer;
-use whitted::trace::intersect::roots;
 use whitted::trace::{RayCounts, SampleTracer};
 
 /// Rays from the hw3 camera through a grid of film positions.

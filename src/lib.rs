@@ -2,8 +2,8 @@
 //!
 //! The data flows through the modules in this order:
 //! scene file → [`scene`] → [`settings`] and [`camera`] → [`trace`] (using the shared
-//! formulas of [`model`]) → [`render`] (the frame buffer) → [`image_io`] (files), the
-//! window or a Python array.
+//! formulas of [`model`] and the ray–sphere roots of [`intersect`]) → [`render`] (the
+//! frame buffer) → [`image_io`] (files), the window or a Python array.
 //!
 //! A scene carries the settings its file gives ([`Scene::image`]); options from a
 //! command line or a program go over them as one more layer of [`Overrides`], and
@@ -48,6 +48,7 @@ pub(crate) mod accel;
 pub mod bench;
 pub mod camera;
 pub mod image_io;
+pub mod intersect;
 pub mod limits;
 pub mod model;
 pub mod render;

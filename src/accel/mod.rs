@@ -15,9 +15,9 @@ use bvh::{Aabb, Bvh};
 use dirgrid::DirGrid;
 pub(crate) use point::{EyeGrid, PointGrid};
 
+use crate::intersect::roots;
 use crate::model::Side;
 use crate::scene::Sphere;
-use crate::trace::intersect::roots;
 
 /// The closest hit of a ray.
 #[derive(Clone, Copy, Debug)]

@@ -7,8 +7,8 @@ use glam::{DVec3, Vec3, Vec4};
 
 use super::dirgrid::DirGrid;
 use super::{round_up, unit64, Best, Hit, Query, Ray, Spheres, QUICK_SLACK};
+use crate::intersect::roots_from;
 use crate::model::Side;
-use crate::trace::intersect::roots_from;
 
 /// A directional grid around a point (the camera origin or a light), with what the
 /// quick test of a ray through that point needs of each sphere worked out once: only

@@ -3,7 +3,6 @@
 //! tracer written for clarity, against which the tests measure the fast one.
 
 pub mod fast;
-pub mod intersect;
 pub mod reference;
 mod row;
 

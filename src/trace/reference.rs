@@ -6,9 +6,9 @@
 
 use glam::{DVec3, Vec3};
 
-use super::intersect::roots;
 use super::{RayCounts, SampleTracer};
 use crate::camera::Camera;
+use crate::intersect::roots;
 use crate::model::{self, Branches, Side};
 
 use crate::scene::{Scene, Sphere};

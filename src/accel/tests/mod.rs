@@ -45,7 +45,7 @@ fn query_ray(q: &Query) -> (DVec3, DVec3) {
 }
 
 /// Independent `f64` ray/sphere roots (unit `d`): `(near, far)`, written here rather
-/// than taken from `trace::intersect` so that the tests do not check it against itself.
+/// than taken from `crate::intersect` so that the tests do not check it against itself.
 /// Distance from the centre to the line via the cross product; roots from the chord.
 fn roots64(o: DVec3, d: DVec3, c: DVec3, r: f64) -> Option<(f64, f64)> {
     let f = c - o;
