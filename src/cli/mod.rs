@@ -1,0 +1,80 @@
+//! The subcommands of the `whitted` binary, one module each; the library does the work.
+
+pub(crate) mod bench;
+pub(crate) mod render;
+
+use std::path::Path;
+
+use anyhow::Context;
+
+use whitted::scene::{self, Scene};
+use whitted::settings::{Overrides, Preset};
+
+/// The built-in scene, embedded from the file the generator wrote
+/// (`whitted scene hw3 > assets/scenes/hw3.toml`); a test keeps the two in step.
+pub(crate) const BUILTIN_SCENE: &str = include_str!("../../assets/scenes/hw3.toml");
+
+pub(crate) fn builtin_scene() -> anyhow::Result<Scene> {
+    let mut scene = Scene::from_toml_str(BUILTIN_SCENE, "assets/scenes/hw3.toml")
+        .context("the built-in scene is broken")?;
+    scene.name = "hw3".into();
+    Ok(scene)
+}
+
+pub(crate) fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
+    match path {
+        None => builtin_scene(),
+        Some(p) => Ok(Scene::load(p)?),
+    }
+}
+
+pub(crate) fn view(path: Option<&Path>, quality: Option<Preset>) -> anyhow::Result<()> {
+    let mut scene = load_scene(path)?;
+    if let Some(preset) = quality {
+        // As if the scene file named it: the viewer's Settings::for_scene applies it.
+        scene.image = scene.image.then(&Overrides {
+            quality: Some(preset),
+            ..Overrides::default()
+        });
+    }
+    whitted::viewer::run(scene)
+}
+
+pub(crate) fn scene_command(seed: u64) -> anyhow::Result<()> {
+    use std::io::Write;
+    let text = scene::hw3_toml(seed);
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        // A reader that stops early (`| head`) is not an error.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        result => result.context("cannot write the scene to standard output"),
+    }
+}
+
+pub(crate) fn time_command(
+    path: Option<&Path>,
+    runs: usize,
+    threads: Option<u32>,
+    orbit: Option<u32>,
+    preview: bool,
+) -> anyhow::Result<()> {
+    let scene = load_scene(path)?;
+    let name = path.map_or("hw3".to_string(), |p| p.display().to_string());
+    if let Some(views) = orbit {
+        let size = (scene.settings().width, scene.settings().height);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.map_or(0, |t| t as usize))
+            .build()
+            .context("cannot start the threads")?;
+        let timing =
+            pool.install(|| whitted::speed::time_orbit(&scene, size, views as usize, preview))?;
+        let line = timing.result_line(&name, pool.current_num_threads(), size);
+        println!("{line}");
+        return Ok(());
+    }
+    let mut opts = scene.settings();
+    opts.threads = threads.map(|t| t as usize);
+    let timing = whitted::speed::time_render(&scene, &opts, runs)?;
+    println!("{}", timing.result_line(&name, &opts, scene.spheres.len()));
+    Ok(())
+}
