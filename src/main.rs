@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 
 use cli::bench::BenchArgs;
 use cli::render::RenderArgs;
+use cli::stitch::StitchArgs;
 use whitted::scene;
 use whitted::settings::Preset;
 
@@ -36,6 +37,8 @@ enum Command {
     },
     /// Render without a window and write image files.
     Render(RenderArgs),
+    /// Put parts written with --tile or --region back together into the whole image.
+    Stitch(StitchArgs),
     /// Time renders of a scene (median of several runs) and print a line in the form
     /// of the peer programs' results (`../shared/peers/run.sh`).
     Time {
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Some(Command::View { scene, quality }) => cli::view(scene.as_deref(), quality),
         Some(Command::Bench(args)) => cli::bench::bench_command(args),
         Some(Command::Render(args)) => cli::render::render_command(args),
+        Some(Command::Stitch(args)) => cli::stitch::stitch_command(args),
         Some(Command::Time {
             scene,
             runs,

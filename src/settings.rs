@@ -224,6 +224,56 @@ pub struct Region {
     pub height: u32,
 }
 
+/// Tile `index` (from 0) of a grid of `count` tiles over the image: a part of the image
+/// for one machine of many (SPEC §5). The grid is the program's choice
+/// ([`Tile::grid`]); a tile is a rectangle, and the tiles cover the image once.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Tile {
+    /// Which tile, from 0, row by row from the top-left.
+    pub index: u32,
+    /// How many tiles.
+    pub count: u32,
+}
+
+impl Tile {
+    /// Columns and rows of `count` tiles over a `width`×`height` image: of the
+    /// factorizations `columns × rows = count` that fit (no tile narrower or lower than
+    /// a pixel), the one whose tiles are closest to square, and of those the one with
+    /// fewer columns (rows of tiles are whole rows of the image's memory).
+    pub fn grid(count: u32, width: u32, height: u32) -> Option<(u32, u32)> {
+        let squareness = |(c, r): (u32, u32)| {
+            let aspect = (f64::from(width) / f64::from(c)) / (f64::from(height) / f64::from(r));
+            aspect.ln().abs()
+        };
+        (1..=count)
+            .filter(|c| count % c == 0)
+            .map(|c| (c, count / c))
+            .filter(|&(c, r)| c <= width && r <= height)
+            .min_by(|&a, &b| squareness(a).total_cmp(&squareness(b)))
+    }
+
+    /// The tile's rectangle in a `width`×`height` image (`None` when the image has
+    /// fewer pixels than tiles in a direction, or the index is out of range). Edges
+    /// fall at `⌊k·width/columns⌋` and `⌊k·height/rows⌋`.
+    pub fn region(&self, width: u32, height: u32) -> Option<Region> {
+        if self.index >= self.count {
+            return None;
+        }
+        let (columns, rows) = Tile::grid(self.count, width, height)?;
+        let edge =
+            |k: u32, n: u32, size: u32| (u64::from(k) * u64::from(size) / u64::from(n)) as u32;
+        let (c, r) = (self.index % columns, self.index / columns);
+        let (x0, x1) = (edge(c, columns, width), edge(c + 1, columns, width));
+        let (y0, y1) = (edge(r, rows, height), edge(r + 1, rows, height));
+        Some(Region {
+            x: x0,
+            y: y0,
+            width: x1 - x0,
+            height: y1 - y0,
+        })
+    }
+}
+
 /// Everything a render needs besides the scene, resolved from the layers of
 /// [`Overrides`] and checked by [`Settings::check`].
 #[derive(Clone, Debug, PartialEq)]
@@ -238,6 +288,8 @@ pub struct Settings {
     pub quality: Quality,
     /// Render only this rectangle of the image (`None`: all of it).
     pub region: Option<Region>,
+    /// Render only this tile of the image (not with a region).
+    pub tile: Option<Tile>,
     /// Worker threads (`None`: all cores).
     pub threads: Option<usize>,
 }
@@ -252,6 +304,7 @@ impl Default for Settings {
             seed: 0,
             quality: Quality::default(),
             region: None,
+            tile: None,
             threads: None,
         }
     }
@@ -276,8 +329,10 @@ pub struct Overrides {
     pub seed: Option<u64>,
     /// The tracer.
     pub precision: Option<Precision>,
-    /// Render only this rectangle.
+    /// Render only this rectangle (a layer's region or tile replaces an earlier one).
     pub region: Option<Region>,
+    /// Render only this tile.
+    pub tile: Option<Tile>,
     /// Worker threads.
     pub threads: Option<usize>,
 }
@@ -306,9 +361,20 @@ impl Overrides {
             max_depth: later.max_depth.or(base.max_depth),
             seed: later.seed.or(base.seed),
             precision: later.precision.or(base.precision),
-            region: later.region.or(base.region),
+            region: part(later, &base).0,
+            tile: part(later, &base).1,
             threads: later.threads.or(base.threads),
         }
+    }
+}
+
+/// The part of the image of `later` over `base`: a region or tile in `later` replaces
+/// both of `base`'s.
+fn part(later: &Overrides, base: &Overrides) -> (Option<Region>, Option<Tile>) {
+    if later.region.is_some() || later.tile.is_some() {
+        (later.region, later.tile)
+    } else {
+        (base.region, base.tile)
     }
 }
 
@@ -325,19 +391,28 @@ impl Settings {
         self.width = o.width.unwrap_or(self.width);
         self.height = o.height.unwrap_or(self.height);
         self.seed = o.seed.unwrap_or(self.seed);
-        self.region = o.region.or(self.region);
+        if o.region.is_some() || o.tile.is_some() {
+            (self.region, self.tile) = (o.region, o.tile);
+        }
         self.threads = o.threads.or(self.threads);
         self
     }
 
-    /// The rectangle to render (the whole image without a region).
+    /// The rectangle to render: the region, the tile's rectangle, or the whole image.
+    /// (A tile that does not fit counts as the whole image; [`Settings::check`]
+    /// refuses it.)
     pub fn area(&self) -> Region {
-        self.region.unwrap_or(Region {
+        let whole = Region {
             x: 0,
             y: 0,
             width: self.width,
             height: self.height,
-        })
+        };
+        match (self.region, self.tile) {
+            (Some(r), _) => r,
+            (None, Some(t)) => t.region(self.width, self.height).unwrap_or(whole),
+            (None, None) => whole,
+        }
     }
 
     /// Checks sizes, samples, depth, the region and the threads against [`crate::limits`]
@@ -362,6 +437,18 @@ impl Settings {
             if !fits {
                 return Err(SettingsError::RegionOutside {
                     region: r,
+                    width,
+                    height,
+                });
+            }
+        }
+        if let Some(t) = self.tile {
+            if self.region.is_some() {
+                return Err(SettingsError::RegionAndTile);
+            }
+            if t.region(width, height).is_none() {
+                return Err(SettingsError::TileOutside {
+                    tile: t,
                     width,
                     height,
                 });
@@ -429,6 +516,22 @@ pub enum SettingsError {
         /// Image height.
         height: u32,
     },
+    /// Both a region and a tile.
+    #[error("give a region or a tile, not both")]
+    RegionAndTile,
+    /// A tile index beyond the count, or more tiles than the image has pixels.
+    #[error(
+        "tile {}/{} does not exist in a {width}x{height} image: expected an index from 0 to {} and at most as many tiles as pixels",
+        tile.index, tile.count, tile.count.saturating_sub(1)
+    )]
+    TileOutside {
+        /// The tile asked for.
+        tile: Tile,
+        /// Image width.
+        width: u32,
+        /// Image height.
+        height: u32,
+    },
     /// Zero worker threads.
     #[error("threads must be at least 1")]
     NoThreads,
@@ -452,10 +555,11 @@ mod tests {
             prop::option::of(0u64..9),
             precision,
             prop::option::of((0u32..9, 0u32..9, 1u32..9, 1u32..9)),
+            prop::option::of((0u32..9, 1u32..9)),
             prop::option::of(1usize..9),
         )
             .prop_map(
-                |(quality, (width, height, spp, max_depth), seed, precision, r, threads)| {
+                |(quality, (width, height, spp, max_depth), seed, precision, r, t, threads)| {
                     Overrides {
                         quality,
                         width,
@@ -470,6 +574,7 @@ mod tests {
                             width,
                             height,
                         }),
+                        tile: t.map(|(index, count)| Tile { index, count }),
                         threads,
                     }
                 },
@@ -557,6 +662,85 @@ mod tests {
             "region 1200,700,81,20 does not fit in the 1280x720 image"
         );
         assert_eq!(bad(&|s| s.threads = Some(0)), "threads must be at least 1");
+    }
+
+    #[test]
+    fn tiles_cover_the_image_once_in_near_square_rectangles() {
+        for (width, height) in [(1280, 720), (7, 3), (1, 1), (3840, 2160), (100, 1)] {
+            for count in 1..=40 {
+                let Some((columns, rows)) = Tile::grid(count, width, height) else {
+                    assert!(count > width * height || (count > width && count > height));
+                    continue;
+                };
+                assert_eq!(columns * rows, count);
+                let mut covered = vec![0u8; (width * height) as usize];
+                for index in 0..count {
+                    let r = Tile { index, count }.region(width, height).unwrap();
+                    assert!(r.width > 0 && r.height > 0, "{count} tiles: {r:?}");
+                    for y in r.y..r.y + r.height {
+                        for x in r.x..r.x + r.width {
+                            covered[(y * width + x) as usize] += 1;
+                        }
+                    }
+                }
+                assert!(covered.iter().all(|&c| c == 1), "{width}x{height} {count}");
+            }
+        }
+        // 16 tiles of a 16:9 image: 4×4 tiles of 320×180 (16:9 again, the squarest
+        // choice of 1×16, 2×8, 4×4, 8×2, 16×1).
+        assert_eq!(Tile::grid(16, 1280, 720), Some((4, 4)));
+        assert_eq!(
+            Tile {
+                index: 5,
+                count: 16
+            }
+            .region(1280, 720),
+            Some(Region {
+                x: 320,
+                y: 180,
+                width: 320,
+                height: 180
+            })
+        );
+        // A prime count: bands across the longer side.
+        assert_eq!(Tile::grid(7, 1280, 720), Some((7, 1)));
+        assert_eq!(Tile { index: 7, count: 7 }.region(1280, 720), None);
+    }
+
+    #[test]
+    fn a_tile_and_a_region_exclude_each_other() {
+        let tile = Tile { index: 1, count: 4 };
+        let s = Settings::default().with(&Overrides {
+            tile: Some(tile),
+            ..Overrides::default()
+        });
+        assert_eq!(s.area(), tile.region(1280, 720).unwrap());
+        let r = Region {
+            x: 1,
+            y: 2,
+            width: 3,
+            height: 4,
+        };
+        let s2 = s.clone().with(&Overrides {
+            region: Some(r),
+            ..Overrides::default()
+        });
+        assert_eq!((s2.region, s2.tile, s2.area()), (Some(r), None, r));
+        let both = Settings::default().with(&Overrides {
+            region: Some(r),
+            tile: Some(tile),
+            ..Overrides::default()
+        });
+        assert_eq!(both.check(), Err(SettingsError::RegionAndTile));
+        let outside = Settings::default().with(&Overrides {
+            tile: Some(Tile { index: 4, count: 4 }),
+            ..Overrides::default()
+        });
+        assert_eq!(
+            outside.check().unwrap_err().to_string(),
+            "tile 4/4 does not exist in a 1280x720 image: expected an index from 0 to 3 and \
+             at most as many tiles as pixels"
+        );
     }
 
     #[test]

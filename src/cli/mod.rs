@@ -2,6 +2,7 @@
 
 pub(crate) mod bench;
 pub(crate) mod render;
+pub(crate) mod stitch;
 
 use std::path::Path;
 

@@ -9,9 +9,10 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, Context};
 use clap::Args;
 
+use whitted::image_io::parts::{self, Placement};
 use whitted::image_io::{self, Format};
 use whitted::render::{self, RenderControl};
-use whitted::settings::{Overrides, Precision, Preset, Region};
+use whitted::settings::{Overrides, Precision, Preset, Region, Tile};
 
 use super::load_scene;
 
@@ -47,6 +48,11 @@ pub(crate) struct RenderArgs {
     /// Render only this rectangle: X,Y,W,H in output pixels, origin top-left.
     #[arg(long, value_name = "X,Y,W,H", value_parser = parse_region)]
     region: Option<Region>,
+    /// Render only tile I (from 0) of a grid of N tiles the program picks (near-square
+    /// rectangles, row by row). PNG and EXR parts record their place for
+    /// `whitted stitch`.
+    #[arg(long, value_name = "I/N", value_parser = parse_tile, conflicts_with = "region")]
+    tile: Option<Tile>,
     /// Use the slow f64 reference renderer.
     #[arg(long)]
     reference: bool,
@@ -71,8 +77,19 @@ impl RenderArgs {
             seed: self.seed,
             precision: self.reference.then_some(Precision::Reference),
             region: self.region,
+            tile: self.tile,
             threads: self.threads.map(|t| t as usize),
         }
+    }
+}
+
+fn parse_tile(text: &str) -> Result<Tile, String> {
+    let parsed = text
+        .split_once('/')
+        .and_then(|(i, n)| Some((i.trim().parse::<u32>().ok()?, n.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((index, count)) if index < count => Ok(Tile { index, count }),
+        _ => Err("expected I/N: tile I of N tiles, 0 <= I < N".into()),
     }
 }
 
@@ -91,7 +108,7 @@ fn parse_region(text: &str) -> Result<Region, String> {
 }
 
 /// An output path whose extension names a format we write (else a usage error).
-fn parse_output(text: &str) -> Result<PathBuf, String> {
+pub(crate) fn parse_output(text: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(text);
     Format::from_path(&path, false).map_err(|e| e.to_string())?;
     Ok(path)
@@ -144,7 +161,12 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
                 path.display()
             ));
         }
-        image_io::save(&frame, path, *format)?;
+        let is_part = opts.region.is_some() || opts.tile.is_some();
+        if is_part && matches!(format, Format::Png | Format::Exr) {
+            parts::save_part(&frame, &Placement::of(&scene, &opts), path, *format)?;
+        } else {
+            image_io::save(&frame, path, *format)?;
+        }
         if !args.quiet {
             eprintln!("wrote {}", path.display());
         }

@@ -9,9 +9,11 @@ use image::codecs::bmp::BmpEncoder;
 use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
 use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
-use image::{DynamicImage, ExtendedColorType, ImageEncoder, ImageFormat, Rgb32FImage, RgbImage};
+use image::{ExtendedColorType, ImageEncoder, Rgb32FImage, RgbImage};
 
 use crate::render::Frame;
+
+pub mod parts;
 
 /// The file formats `whitted` writes, chosen by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,6 +62,9 @@ pub enum EncodeError {
     /// The encoder of the `image` crate failed.
     #[error(transparent)]
     Image(#[from] image::ImageError),
+    /// The OpenEXR encoder failed.
+    #[error(transparent)]
+    Exr(#[from] exr::error::Error),
     /// EXR holds linear values: it is encoded from a frame, not from 8-bit bytes.
     #[error("EXR is written from linear values, not bytes")]
     ExrFromBytes,
@@ -256,8 +261,7 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
 pub fn encode(frame: &Frame, format: Format) -> Result<Vec<u8>, EncodeError> {
     let mut out = Vec::new();
     match format {
-        Format::Exr => DynamicImage::ImageRgb32F(to_rgb32f(frame))
-            .write_to(&mut Cursor::new(&mut out), ImageFormat::OpenExr)?,
+        Format::Exr => out = exr_bytes(&to_rgb32f(frame), None)?,
         _ => encode_rgb8(&to_rgb8(frame), format, &mut out)?,
     }
     Ok(out)
@@ -270,4 +274,40 @@ pub fn save(frame: &Frame, path: &Path, format: Format) -> Result<(), SaveError>
         message: format!("cannot encode: {e}"),
     })?;
     write_atomically(path, &bytes)
+}
+
+/// Linear RGB (top row first) as OpenEXR, through the `exr` crate: the whole image, or
+/// with `part`, a part whose data window sits at its place in the whole image's
+/// display window and whose header records the placement (see [`parts`]). Written on
+/// one thread, so the chunks come in order and the same pixels give the same bytes.
+pub(crate) fn exr_bytes(
+    image: &Rgb32FImage,
+    part: Option<&parts::Placement>,
+) -> Result<Vec<u8>, EncodeError> {
+    use exr::meta::attribute::{AttributeValue, IntegerBounds, Text};
+    use exr::prelude::{
+        Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage,
+    };
+    let size = (image.width() as usize, image.height() as usize);
+    let mut attributes = LayerAttributes::default();
+    if let Some(p) = part {
+        attributes.layer_position = Vec2(p.region.x as i32, p.region.y as i32);
+        attributes.other.insert(
+            Text::from(parts::KEY),
+            AttributeValue::Text(Text::from(p.to_text().as_str())),
+        );
+    }
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let px = image.get_pixel(p.x() as u32, p.y() as u32);
+        (px[0], px[1], px[2])
+    });
+    let mut exr_image =
+        Image::from_layer(Layer::new(size, attributes, Encoding::default(), channels));
+    if let Some(p) = part {
+        exr_image.attributes.display_window =
+            IntegerBounds::new((0, 0), (p.width as usize, p.height as usize));
+    }
+    let mut out = Cursor::new(Vec::new());
+    exr_image.write().non_parallel().to_buffered(&mut out)?;
+    Ok(out.into_inner())
 }

@@ -1,0 +1,51 @@
+//! `whitted stitch`: parts written with `--tile` or `--region` put back together into
+//! the whole image, byte for byte what rendering it whole writes.
+
+use std::path::PathBuf;
+
+use anyhow::bail;
+use clap::Args;
+
+use whitted::image_io::parts::{self, PartPixels};
+use whitted::image_io::{self, Format};
+
+#[derive(Args)]
+pub(crate) struct StitchArgs {
+    /// The whole image, format by extension: .ppm .png .bmp .jpg from PNG parts; any,
+    /// .exr included, from EXR parts.
+    #[arg(short, long = "output", value_name = "FILE", value_parser = super::render::parse_output)]
+    output: PathBuf,
+    /// Write binary PPM (P6) instead of plain (P3).
+    #[arg(long)]
+    ppm_binary: bool,
+    /// The parts (PNG or EXR files written with --tile or --region).
+    #[arg(required = true, value_name = "PART")]
+    parts: Vec<PathBuf>,
+}
+
+pub(crate) fn stitch_command(args: StitchArgs) -> anyhow::Result<()> {
+    let format = Format::from_path(&args.output, args.ppm_binary)?;
+    image_io::check_writable(&args.output)?;
+    let read: Vec<(String, parts::Part)> = args
+        .parts
+        .iter()
+        .map(|p| Ok((p.display().to_string(), parts::read_part(p)?)))
+        .collect::<Result<_, parts::StitchError>>()?;
+    match parts::stitch(&read)? {
+        PartPixels::Linear(image) => {
+            image_io::save(&parts::frame_of(&image), &args.output, format)?;
+        }
+        PartPixels::Bytes(image) => {
+            if format == Format::Exr {
+                bail!(
+                    "{}: 8-bit PNG parts cannot make an EXR file (render the parts as .exr)",
+                    args.output.display()
+                );
+            }
+            let mut bytes = Vec::new();
+            image_io::encode_rgb8(&image, format, &mut bytes)?;
+            image_io::write_atomically(&args.output, &bytes)?;
+        }
+    }
+    Ok(())
+}

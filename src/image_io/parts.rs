@@ -1,0 +1,403 @@
+//! Parts of a big image (SPEC §5): a render of a region or tile records in its file
+//! where it belongs in the whole image, and [`stitch`] puts parts back together into
+//! exactly the whole image, or refuses (gaps, overlaps, parts of different images).
+//!
+//! The record lives in the file itself: a PNG `tEXt` chunk `whitted-part`, and in EXR
+//! the standard data window (the part's pixels) inside the display window (the whole
+//! image), with the same text as a header attribute. Other formats cannot carry it.
+
+use std::path::Path;
+
+use glam::Vec3;
+use image::{Rgb32FImage, RgbImage};
+
+use super::{exr_bytes, to_rgb32f, to_rgb8, write_atomically, Format, SaveError};
+use crate::render::Frame;
+use crate::scene::{to_toml, Scene};
+use crate::settings::{Region, Settings};
+
+/// The PNG text keyword and EXR attribute name of the record.
+pub(super) const KEY: &str = "whitted-part";
+
+/// Where a part belongs: its rectangle in the whole image (origin top-left), the whole
+/// image's size, and a fingerprint of what was rendered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Placement {
+    /// The part's rectangle in the whole image.
+    pub region: Region,
+    /// The whole image's width.
+    pub width: u32,
+    /// The whole image's height.
+    pub height: u32,
+    /// [`image_id`] of the scene and settings: parts of one image share it.
+    pub image: u64,
+}
+
+impl Placement {
+    /// The placement of what `settings` renders of `scene`.
+    pub fn of(scene: &Scene, settings: &Settings) -> Placement {
+        Placement {
+            region: settings.area(),
+            width: settings.width,
+            height: settings.height,
+            image: image_id(scene, settings),
+        }
+    }
+
+    pub(super) fn to_text(self) -> String {
+        let r = self.region;
+        format!(
+            "region={},{},{},{} image={}x{} id={:016x}",
+            r.x, r.y, r.width, r.height, self.width, self.height, self.image
+        )
+    }
+
+    fn from_text(text: &str) -> Option<Placement> {
+        let mut region = None;
+        let mut size = None;
+        let mut id = None;
+        for field in text.split_whitespace() {
+            let (key, value) = field.split_once('=')?;
+            match key {
+                "region" => {
+                    let n: Vec<u32> = value
+                        .split(',')
+                        .map(str::parse)
+                        .collect::<Result<_, _>>()
+                        .ok()?;
+                    if let [x, y, width, height] = n[..] {
+                        region = Some(Region {
+                            x,
+                            y,
+                            width,
+                            height,
+                        });
+                    }
+                }
+                "image" => {
+                    let (w, h) = value.split_once('x')?;
+                    size = Some((w.parse().ok()?, h.parse().ok()?));
+                }
+                "id" => id = Some(u64::from_str_radix(value, 16).ok()?),
+                _ => {}
+            }
+        }
+        let (width, height) = size?;
+        let placement = Placement {
+            region: region?,
+            width,
+            height,
+            image: id?,
+        };
+        let r = placement.region;
+        let fits = r.width > 0
+            && r.height > 0
+            && u64::from(r.x) + u64::from(r.width) <= u64::from(width)
+            && u64::from(r.y) + u64::from(r.height) <= u64::from(height);
+        fits.then_some(placement)
+    }
+}
+
+/// A fingerprint of the image that `settings` make of `scene`, whatever part of it is
+/// rendered and on how many threads: FNV-1a of the scene's text and the settings.
+pub fn image_id(scene: &Scene, settings: &Settings) -> u64 {
+    let whole = Settings {
+        region: None,
+        tile: None,
+        threads: None,
+        ..settings.clone()
+    };
+    let text = format!("{}\n{whole:?}", to_toml(scene));
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// Saves a part with its placement: PNG and EXR only (the formats that carry it).
+pub fn save_part(
+    frame: &Frame,
+    placement: &Placement,
+    path: &Path,
+    format: Format,
+) -> Result<(), SaveError> {
+    let err = |message: String| SaveError {
+        path: path.display().to_string(),
+        message,
+    };
+    let bytes = match format {
+        Format::Png => png_part(&to_rgb8(frame), placement),
+        Format::Exr => exr_bytes(&to_rgb32f(frame), Some(placement)).map_err(|e| e.to_string()),
+        _ => {
+            return Err(err(
+                "a part records its place in the image only in PNG and EXR files".into(),
+            ))
+        }
+    }
+    .map_err(|e| err(format!("cannot encode: {e}")))?;
+    write_atomically(path, &bytes)
+}
+
+fn png_part(image: &RgbImage, placement: &Placement) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    let mut encoder = png::Encoder::new(&mut out, image.width(), image.height());
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder
+        .add_text_chunk(KEY.into(), placement.to_text())
+        .map_err(|e| e.to_string())?;
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer
+        .write_image_data(image.as_raw())
+        .map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())?;
+    Ok(out)
+}
+
+/// A part read back: where it belongs and its pixels (top row first).
+#[derive(Clone, Debug)]
+pub struct Part {
+    /// Where the part belongs.
+    pub placement: Placement,
+    /// Its pixels.
+    pub pixels: PartPixels,
+}
+
+/// The pixels of a part, as its file holds them.
+#[derive(Clone, Debug)]
+pub enum PartPixels {
+    /// 8-bit RGB (from PNG).
+    Bytes(RgbImage),
+    /// Linear values (from EXR).
+    Linear(Rgb32FImage),
+}
+
+/// Why parts could not be read or put together.
+#[derive(Debug, thiserror::Error)]
+pub enum StitchError {
+    /// A file that cannot be read as a part.
+    #[error("{path}: {message}")]
+    Unreadable {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Parts that belong to different images (size, scene or settings).
+    #[error("{path} is a part of another image ({theirs}) than {first} ({ours})")]
+    OtherImage {
+        /// The part that differs.
+        path: String,
+        /// The first part.
+        first: String,
+        /// The first part's image.
+        ours: String,
+        /// This part's image.
+        theirs: String,
+    },
+    /// PNG parts mixed with EXR parts.
+    #[error("{path}: parts must all be PNG or all be EXR")]
+    MixedKinds {
+        /// The part that differs.
+        path: String,
+    },
+    /// Two parts cover one pixel.
+    #[error("{a} and {b} overlap (at pixel {x},{y})")]
+    Overlap {
+        /// One part.
+        a: String,
+        /// The other.
+        b: String,
+        /// A pixel both cover (origin top-left).
+        x: u32,
+        /// Its row.
+        y: u32,
+    },
+    /// Pixels no part covers.
+    #[error("the parts leave {missing} pixels of the {width}x{height} image uncovered (the first at {x},{y})")]
+    Gap {
+        /// Uncovered pixels.
+        missing: u64,
+        /// Image width.
+        width: u32,
+        /// Image height.
+        height: u32,
+        /// The first uncovered pixel.
+        x: u32,
+        /// Its row.
+        y: u32,
+    },
+    /// No parts at all.
+    #[error("no parts given")]
+    NoParts,
+}
+
+/// Reads a part written by [`save_part`].
+pub fn read_part(path: &Path) -> Result<Part, StitchError> {
+    let unreadable = |message: String| StitchError::Unreadable {
+        path: path.display().to_string(),
+        message,
+    };
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "png" => read_png_part(path).map_err(unreadable),
+        "exr" => read_exr_part(path).map_err(unreadable),
+        _ => Err(unreadable(
+            "not a part: parts are PNG or EXR files written with --tile or --region".into(),
+        )),
+    }
+}
+
+fn no_record() -> String {
+    "records no place in an image: not written with --tile or --region".into()
+}
+
+fn read_png_part(path: &Path) -> Result<Part, String> {
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let decoder = png::Decoder::new(std::io::BufReader::new(file));
+    let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
+    let placement = reader
+        .info()
+        .uncompressed_latin1_text
+        .iter()
+        .find(|t| t.keyword == KEY)
+        .and_then(|t| Placement::from_text(&t.text))
+        .ok_or_else(no_record)?;
+    let info = reader.info();
+    if (info.color_type, info.bit_depth) != (png::ColorType::Rgb, png::BitDepth::Eight) {
+        return Err("not an 8-bit RGB PNG".into());
+    }
+    let mut buf = vec![0; reader.output_buffer_size().ok_or("an image too large")?];
+    let frame = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
+    buf.truncate(frame.buffer_size());
+    let image = RgbImage::from_raw(frame.width, frame.height, buf).ok_or("a short image")?;
+    check_size(&placement, image.width(), image.height())?;
+    Ok(Part {
+        placement,
+        pixels: PartPixels::Bytes(image),
+    })
+}
+
+fn read_exr_part(path: &Path) -> Result<Part, String> {
+    use exr::meta::attribute::AttributeValue;
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| Rgb32FImage::new(resolution.width() as u32, resolution.height() as u32),
+        |pixels: &mut Rgb32FImage, p, (r, g, b, _a): (f32, f32, f32, f32)| {
+            pixels.put_pixel(p.x() as u32, p.y() as u32, image::Rgb([r, g, b]))
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let attributes = &image.layer_data.attributes;
+    let placement = match attributes.other.get(&exr::meta::attribute::Text::from(KEY)) {
+        Some(AttributeValue::Text(t)) => Placement::from_text(&t.to_string()),
+        _ => None,
+    }
+    .ok_or_else(no_record)?;
+    let pixels = image.layer_data.channel_data.pixels;
+    let origin = attributes.layer_position;
+    let r = placement.region;
+    if (origin.x(), origin.y()) != (r.x as i32, r.y as i32) {
+        return Err("its data window disagrees with its record".into());
+    }
+    check_size(&placement, pixels.width(), pixels.height())?;
+    Ok(Part {
+        placement,
+        pixels: PartPixels::Linear(pixels),
+    })
+}
+
+fn check_size(placement: &Placement, width: u32, height: u32) -> Result<(), String> {
+    let r = placement.region;
+    if (width, height) != (r.width, r.height) {
+        return Err(format!(
+            "holds {width}x{height} pixels for a {}x{} part",
+            r.width, r.height
+        ));
+    }
+    Ok(())
+}
+
+/// The whole image put together from `parts` (with the paths they came from, for
+/// messages): 8-bit from PNG parts, a linear frame from EXR parts. Every pixel must be
+/// covered exactly once by parts of one image.
+pub fn stitch(parts: &[(String, Part)]) -> Result<PartPixels, StitchError> {
+    let (first_path, first) = parts.first().ok_or(StitchError::NoParts)?;
+    let p0 = first.placement;
+    let describe = |p: &Placement| format!("{}x{}, id {:016x}", p.width, p.height, p.image);
+    let (w, h) = (p0.width, p0.height);
+    let mut owner: Vec<u32> = vec![u32::MAX; w as usize * h as usize];
+    for (k, (path, part)) in parts.iter().enumerate() {
+        let p = part.placement;
+        if (p.width, p.height, p.image) != (p0.width, p0.height, p0.image) {
+            return Err(StitchError::OtherImage {
+                path: path.clone(),
+                first: first_path.clone(),
+                ours: describe(&p0),
+                theirs: describe(&p),
+            });
+        }
+        if std::mem::discriminant(&part.pixels) != std::mem::discriminant(&first.pixels) {
+            return Err(StitchError::MixedKinds { path: path.clone() });
+        }
+        let r = p.region;
+        for y in r.y..r.y + r.height {
+            for x in r.x..r.x + r.width {
+                let slot = &mut owner[y as usize * w as usize + x as usize];
+                if *slot != u32::MAX {
+                    return Err(StitchError::Overlap {
+                        a: parts[*slot as usize].0.clone(),
+                        b: path.clone(),
+                        x,
+                        y,
+                    });
+                }
+                *slot = k as u32;
+            }
+        }
+    }
+    let missing = owner.iter().filter(|&&o| o == u32::MAX).count() as u64;
+    if let Some(at) = owner.iter().position(|&o| o == u32::MAX) {
+        return Err(StitchError::Gap {
+            missing,
+            width: w,
+            height: h,
+            x: at as u32 % w,
+            y: at as u32 / w,
+        });
+    }
+    Ok(match &first.pixels {
+        PartPixels::Bytes(_) => {
+            let mut whole = RgbImage::new(w, h);
+            for (_, part) in parts {
+                if let PartPixels::Bytes(img) = &part.pixels {
+                    let r = part.placement.region;
+                    image::imageops::replace(&mut whole, img, i64::from(r.x), i64::from(r.y));
+                }
+            }
+            PartPixels::Bytes(whole)
+        }
+        PartPixels::Linear(_) => {
+            let mut whole = Rgb32FImage::new(w, h);
+            for (_, part) in parts {
+                if let PartPixels::Linear(img) = &part.pixels {
+                    let r = part.placement.region;
+                    image::imageops::replace(&mut whole, img, i64::from(r.x), i64::from(r.y));
+                }
+            }
+            PartPixels::Linear(whole)
+        }
+    })
+}
+
+/// A frame (rows from the bottom) from linear pixels stored top row first.
+pub fn frame_of(image: &Rgb32FImage) -> Frame {
+    let (w, h) = image.dimensions();
+    let mut frame = Frame::new(w, h);
+    for (x, y, p) in image.enumerate_pixels() {
+        frame.pixels[(h - 1 - y) as usize * w as usize + x as usize] = Vec3::from_array(p.0);
+    }
+    frame
+}

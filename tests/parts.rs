@@ -1,0 +1,215 @@
+//! Parts of an image (SPEC §5): `--tile I/N` and `--region` files record where they
+//! belong, and `whitted stitch` puts them back into exactly the bytes of the whole
+//! render, or refuses with one line and writes nothing.
+#![cfg(all(feature = "cli", feature = "viewer"))]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn whitted(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_whitted"))
+        .args(args)
+        .output()
+        .expect("run whitted")
+}
+
+fn ok(args: &[&str]) {
+    let out = whitted(args);
+    assert!(
+        out.status.success(),
+        "whitted {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Runs a command that must fail with `code` and one line on stderr containing `needle`.
+fn fails(args: &[&str], code: i32, needle: &str) {
+    let out = whitted(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "whitted {args:?}: {err}");
+    assert_eq!(err.lines().count(), 1, "one line: {err}");
+    assert!(err.contains(needle), "{needle:?} not in {err}");
+}
+
+fn path(dir: &Path, name: &str) -> String {
+    dir.join(name).to_str().unwrap().to_string()
+}
+
+const SIZE: [&str; 4] = ["--width", "160", "--height", "90"];
+
+/// Renders tiles `0..count` of hw3 at 160×90 with `extra` options into `dir` as `ext`.
+fn tiles(dir: &Path, count: u32, ext: &str, extra: &[&str]) -> Vec<String> {
+    (0..count)
+        .map(|i| {
+            let file = path(dir, &format!("tile{i}.{ext}"));
+            let tile = format!("{i}/{count}");
+            let mut args = vec!["render", "--quiet", "--tile", &tile, "-o", &file];
+            args.extend(SIZE);
+            args.extend(extra);
+            ok(&args);
+            file
+        })
+        .collect()
+}
+
+fn stitch(out: &str, parts: &[String]) -> Output {
+    let mut args = vec!["stitch", "-o", out];
+    args.extend(parts.iter().map(String::as_str));
+    whitted(&args)
+}
+
+fn same_bytes(a: &str, b: &str) {
+    let (x, y) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
+    assert!(
+        x == y,
+        "{a} and {b} differ ({} and {} bytes)",
+        x.len(),
+        y.len()
+    );
+}
+
+#[test]
+fn tiles_stitch_into_the_bytes_of_the_whole_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (count, extra) in [(16, &[][..]), (7, &["--spp", "4"][..]), (1, &[][..])] {
+        let whole_png = path(d, "whole.png");
+        let whole_exr = path(d, "whole.exr");
+        let whole_ppm = path(d, "whole.ppm");
+        let mut args = vec![
+            "render", "--quiet", "-o", &whole_png, "-o", &whole_exr, "-o", &whole_ppm,
+        ];
+        args.extend(SIZE);
+        args.extend(extra);
+        ok(&args);
+
+        let pngs = tiles(d, count, "png", extra);
+        let out = path(d, "stitched.png");
+        assert!(stitch(&out, &pngs).status.success());
+        same_bytes(&out, &whole_png);
+        let ppm = path(d, "stitched.ppm");
+        assert!(stitch(&ppm, &pngs).status.success());
+        same_bytes(&ppm, &whole_ppm);
+
+        let exrs = tiles(d, count, "exr", extra);
+        let out = path(d, "stitched.exr");
+        assert!(stitch(&out, &exrs).status.success());
+        same_bytes(&out, &whole_exr);
+        // The order of the parts does not matter.
+        let mut reversed = exrs.clone();
+        reversed.reverse();
+        assert!(stitch(&out, &reversed).status.success());
+        same_bytes(&out, &whole_exr);
+    }
+}
+
+#[test]
+fn regions_of_any_shape_stitch_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let whole = path(d, "whole.png");
+    let mut args = vec!["render", "--quiet", "--quality", "default", "-o", &whole];
+    args.extend(SIZE);
+    ok(&args);
+    let mut parts = Vec::new();
+    for (k, region) in ["0,0,160,31", "0,31,13,59", "13,31,147,59"]
+        .iter()
+        .enumerate()
+    {
+        let file = path(d, &format!("r{k}.png"));
+        let mut args = vec![
+            "render",
+            "--quiet",
+            "--quality",
+            "default",
+            "--region",
+            region,
+            "-o",
+            &file,
+        ];
+        args.extend(SIZE);
+        ok(&args);
+        parts.push(file);
+    }
+    let out = path(d, "out.png");
+    assert!(stitch(&out, &parts).status.success());
+    same_bytes(&out, &whole);
+}
+
+#[test]
+fn gaps_overlaps_and_foreign_parts_are_refused_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let pngs = tiles(d, 4, "png", &[]);
+    let out = path(d, "out.png");
+    let mut args = vec!["stitch", "-o", &out];
+    args.extend(pngs[..3].iter().map(String::as_str));
+    fails(&args, 1, "uncovered");
+
+    let mut args = vec!["stitch", "-o", &out];
+    args.extend(pngs.iter().map(String::as_str));
+    args.push(&pngs[2]);
+    fails(&args, 1, "overlap");
+
+    // The same tile of another image (another seed for the small balls' jitter is
+    // not enough at 1 spp: another size is).
+    let other = path(d, "other.png");
+    ok(&[
+        "render", "--quiet", "--tile", "3/4", "--width", "160", "--height", "91", "-o", &other,
+    ]);
+    let mut args = vec!["stitch", "-o", &out];
+    args.extend(pngs[..3].iter().map(String::as_str));
+    args.push(&other);
+    fails(&args, 1, "part of another image");
+
+    // Another scene with the same size.
+    let scene = path(d, "s.toml");
+    std::fs::write(&scene, "[[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\n").unwrap();
+    let foreign = path(d, "foreign.png");
+    let mut args = vec!["render", &scene, "--quiet", "--tile", "3/4", "-o", &foreign];
+    args.extend(SIZE);
+    ok(&args);
+    let mut args = vec!["stitch", "-o", &out];
+    args.extend(pngs[..3].iter().map(String::as_str));
+    args.push(&foreign);
+    fails(&args, 1, "part of another image");
+
+    // A whole image is no part; PNG and EXR parts do not mix; 8-bit parts make no EXR.
+    let whole = path(d, "whole.png");
+    let mut args = vec!["render", "--quiet", "-o", &whole];
+    args.extend(SIZE);
+    ok(&args);
+    fails(&["stitch", "-o", &out, &whole], 1, "records no place");
+    let exr = tiles(d, 4, "exr", &[]);
+    fails(
+        &["stitch", "-o", &out, &pngs[0], &pngs[1], &pngs[2], &exr[3]],
+        1,
+        "all be PNG or all be EXR",
+    );
+    let out_exr = path(d, "out.exr");
+    let mut args = vec!["stitch", "-o", &out_exr];
+    args.extend(pngs.iter().map(String::as_str));
+    fails(&args, 1, "cannot make an EXR");
+    assert!(!PathBuf::from(&out).exists() && !PathBuf::from(&out_exr).exists());
+}
+
+#[test]
+fn bad_tiles_are_usage_errors() {
+    fails(&["render", "--tile", "4/4", "-o", "x.png"], 2, "0 <= I < N");
+    fails(&["render", "--tile", "a/b", "-o", "x.png"], 2, "I/N");
+    fails(
+        &[
+            "render", "--tile", "0/2", "--region", "0,0,1,1", "-o", "x.png",
+        ],
+        2,
+        "cannot be used with",
+    );
+    // More tiles than the image has rows and columns for.
+    fails(
+        &[
+            "render", "--tile", "0/7", "--width", "2", "--height", "3", "-o", "x.png",
+        ],
+        1,
+        "does not exist in a 2x3 image",
+    );
+}
