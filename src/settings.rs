@@ -246,7 +246,7 @@ impl Tile {
             aspect.ln().abs()
         };
         (1..=count)
-            .filter(|c| count % c == 0)
+            .filter(|&c| count.is_multiple_of(c))
             .map(|c| (c, count / c))
             .filter(|&(c, r)| c <= width && r <= height)
             .min_by(|&a, &b| squareness(a).total_cmp(&squareness(b)))
