@@ -3,7 +3,10 @@
 #   1. the whole crate with its default features (the command line and the window);
 #   2. the core library alone (`--no-default-features`): its unit tests, the
 #      integration tests that need no binary, and the doc examples;
-#   3. the core's dependency tree holds none of the shells' crates.
+#   3. the core's dependency tree holds none of the shells' crates;
+#   4. the Python package (python/), built by maturin into a virtual environment
+#      made here (target/python-env), with its tests: the module against the command
+#      line, and `whitted.distributed` on a Dask cluster started on 127.0.0.1.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -25,3 +28,11 @@ if [ -n "$found" ]; then
     exit 1
 fi
 echo "ok: none of $shells"
+
+echo "== the Python package"
+venv=target/python-env
+[ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+"$venv/bin/pip" install --quiet --upgrade pip
+"$venv/bin/pip" install --quiet "maturin>=1.16,<2" numpy pytest dask distributed tqdm
+PATH="$PWD/$venv/bin:$PATH" "$venv/bin/pip" install --quiet --no-build-isolation --force-reinstall --no-deps ./python
+WHITTED_BIN="$PWD/target/release/whitted" "$venv/bin/python" -m pytest -q python/tests

@@ -1,0 +1,390 @@
+//! The Python module `whitted` (SPEC §7): scenes in, numpy arrays out, through the
+//! same library calls as the command line, so that the same options give the same
+//! bytes. The GIL is released while a render runs; Ctrl-C cancels it.
+#![forbid(unsafe_code)]
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray3, PyUntypedArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+use whitted::image_io::{self, Format};
+use whitted::render::{Frame, RenderControl};
+use whitted::settings::{Overrides, Precision, Preset, Region, Settings, Tile};
+
+create_exception!(
+    whitted,
+    SceneError,
+    PyValueError,
+    "A scene that cannot be loaded; `.path`, `.line` and `.column` say where."
+);
+
+/// A scene error as Python's `SceneError`, with its position as attributes.
+fn scene_error(py: Python<'_>, e: whitted::SceneError) -> PyErr {
+    let err = SceneError::new_err(e.to_string());
+    let value = err.value(py);
+    let _ = value.setattr("path", e.path.clone());
+    let _ = value.setattr("line", e.line);
+    let _ = value.setattr("column", e.column);
+    let _ = value.setattr("message", e.message.clone());
+    err
+}
+
+/// A validated scene: spheres, lights, sky, camera and its file's image settings.
+/// Pickles as its TOML text, so it travels to other processes.
+#[pyclass(module = "whitted", name = "Scene", frozen)]
+struct PyScene {
+    inner: whitted::Scene,
+}
+
+#[pymethods]
+impl PyScene {
+    /// A short name (the file's stem, or "hw3").
+    #[getter]
+    fn name(&self) -> &str {
+        &self.inner.name
+    }
+
+    /// How many spheres the scene holds.
+    #[getter]
+    fn spheres(&self) -> usize {
+        self.inner.spheres.len()
+    }
+
+    /// How many point lights the scene holds.
+    #[getter]
+    fn lights(&self) -> usize {
+        self.inner.lights.len()
+    }
+
+    /// The scene as a scene file (TOML); `parse_scene` of it gives the scene back.
+    fn to_toml(&self) -> String {
+        whitted::scene::to_toml(&self.inner)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<whitted.Scene {:?}: {} spheres, {} lights>",
+            self.inner.name,
+            self.inner.spheres.len(),
+            self.inner.lights.len()
+        )
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let rebuild = py.import("whitted._whitted")?.getattr("_scene_from_toml")?;
+        let args = (self.to_toml(), self.inner.name.clone());
+        (rebuild, args).into_pyobject(py)
+    }
+}
+
+/// Rebuilds a pickled scene.
+#[pyfunction]
+fn _scene_from_toml(py: Python<'_>, text: &str, name: String) -> PyResult<PyScene> {
+    let mut inner = whitted::Scene::from_toml_str(text, &name).map_err(|e| scene_error(py, e))?;
+    inner.name = name;
+    Ok(PyScene { inner })
+}
+
+/// Reads, parses and validates a scene file.
+#[pyfunction]
+fn load_scene(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
+    let inner = py
+        .detach(|| whitted::Scene::load(&path))
+        .map_err(|e| scene_error(py, e))?;
+    Ok(PyScene { inner })
+}
+
+/// Parses and validates scene text; `path` names it in errors.
+#[pyfunction]
+#[pyo3(signature = (text, path = "<string>"))]
+fn parse_scene(py: Python<'_>, text: &str, path: &str) -> PyResult<PyScene> {
+    let inner = whitted::Scene::from_toml_str(text, path).map_err(|e| scene_error(py, e))?;
+    Ok(PyScene { inner })
+}
+
+/// The built-in scene of the assignment, its 48 small balls drawn from `seed`.
+#[pyfunction]
+#[pyo3(signature = (seed = whitted::scene::HW3_DEFAULT_SEED))]
+fn hw3_scene(seed: u64) -> PyScene {
+    PyScene {
+        inner: whitted::scene::hw3_scene(seed),
+    }
+}
+
+/// A rectangle `(x, y, width, height)`, origin top-left.
+type Rect = (u32, u32, u32, u32);
+
+/// The keyword options of `render` and `render_linear`, as the command line's.
+#[derive(Default)]
+struct Options {
+    width: Option<u32>,
+    height: Option<u32>,
+    spp: Option<u32>,
+    depth: Option<u32>,
+    seed: Option<u64>,
+    quality: Option<String>,
+    region: Option<Rect>,
+    tile: Option<(u32, u32)>,
+    threads: Option<usize>,
+    reference: bool,
+}
+
+impl Options {
+    /// The settings these options make of `scene`'s, checked.
+    fn settings(&self, scene: &whitted::Scene) -> PyResult<Settings> {
+        let quality = match &self.quality {
+            None => None,
+            Some(name) => Some(
+                name.parse::<Preset>()
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?,
+            ),
+        };
+        let overrides = Overrides {
+            quality,
+            width: self.width,
+            height: self.height,
+            spp: self.spp,
+            max_depth: self.depth,
+            seed: self.seed,
+            precision: self.reference.then_some(Precision::Reference),
+            region: self.region.map(|(x, y, width, height)| Region {
+                x,
+                y,
+                width,
+                height,
+            }),
+            tile: self.tile.map(|(index, count)| Tile { index, count }),
+            threads: self.threads,
+        };
+        let settings = scene.settings().with(&overrides);
+        settings
+            .check()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(settings)
+    }
+}
+
+macro_rules! options {
+    ($width:ident, $height:ident, $spp:ident, $depth:ident, $seed:ident, $quality:ident,
+     $region:ident, $tile:ident, $threads:ident, $reference:ident) => {
+        Options {
+            width: $width,
+            height: $height,
+            spp: $spp,
+            depth: $depth,
+            seed: $seed,
+            quality: $quality,
+            region: $region,
+            tile: $tile,
+            threads: $threads,
+            reference: $reference,
+        }
+    };
+}
+
+/// Renders with the GIL released, polling for Ctrl-C: a signal cancels the render
+/// (within a row of pixels) and raises `KeyboardInterrupt`.
+fn render_frame(py: Python<'_>, scene: &whitted::Scene, settings: &Settings) -> PyResult<Frame> {
+    let control = RenderControl::default();
+    let outcome = py.detach(|| {
+        std::thread::scope(|s| {
+            let job = s.spawn(|| whitted::render(scene, settings, &control));
+            loop {
+                if job.is_finished() {
+                    return Ok(job.join());
+                }
+                // Python's signal handler only sets a flag; it is read with the GIL.
+                if let Err(interrupt) = Python::attach(|py| py.check_signals()) {
+                    control.cancel();
+                    let _ = job.join();
+                    return Err(interrupt);
+                }
+                std::thread::sleep(Duration::from_millis(10));
+            }
+        })
+    })?;
+    match outcome {
+        Ok(Ok((frame, _stats))) => Ok(frame),
+        Ok(Err(e)) => Err(PyValueError::new_err(e.to_string())),
+        Err(_) => Err(PyRuntimeError::new_err("the render panicked")),
+    }
+}
+
+/// Renders `scene` to 8-bit RGB: a numpy array `(height, width, 3)` of `uint8`, top
+/// row first, the bytes `whitted render -o x.png` writes with the same options.
+#[pyfunction]
+#[pyo3(signature = (scene, *, width=None, height=None, spp=None, depth=None, seed=None,
+    quality=None, region=None, tile=None, threads=None, reference=false))]
+#[allow(clippy::too_many_arguments)]
+fn render<'py>(
+    py: Python<'py>,
+    scene: &PyScene,
+    width: Option<u32>,
+    height: Option<u32>,
+    spp: Option<u32>,
+    depth: Option<u32>,
+    seed: Option<u64>,
+    quality: Option<String>,
+    region: Option<Rect>,
+    tile: Option<(u32, u32)>,
+    threads: Option<usize>,
+    reference: bool,
+) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    let options =
+        options!(width, height, spp, depth, seed, quality, region, tile, threads, reference);
+    let settings = options.settings(&scene.inner)?;
+    let frame = render_frame(py, &scene.inner, &settings)?;
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let bytes = image_io::to_rgb8(&frame).into_raw();
+    PyArray1::from_vec(py, bytes).reshape([h, w, 3])
+}
+
+/// Renders `scene` to linear RGB: a numpy array `(height, width, 3)` of `float32`, top
+/// row first, the values `whitted render -o x.exr` writes with the same options.
+#[pyfunction]
+#[pyo3(signature = (scene, *, width=None, height=None, spp=None, depth=None, seed=None,
+    quality=None, region=None, tile=None, threads=None, reference=false))]
+#[allow(clippy::too_many_arguments)]
+fn render_linear<'py>(
+    py: Python<'py>,
+    scene: &PyScene,
+    width: Option<u32>,
+    height: Option<u32>,
+    spp: Option<u32>,
+    depth: Option<u32>,
+    seed: Option<u64>,
+    quality: Option<String>,
+    region: Option<Rect>,
+    tile: Option<(u32, u32)>,
+    threads: Option<usize>,
+    reference: bool,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let options =
+        options!(width, height, spp, depth, seed, quality, region, tile, threads, reference);
+    let settings = options.settings(&scene.inner)?;
+    let frame = render_frame(py, &scene.inner, &settings)?;
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let values = image_io::to_rgb32f(&frame).into_raw();
+    PyArray1::from_vec(py, values).reshape([h, w, 3])
+}
+
+/// The size `(width, height)` and the rectangle `(x, y, w, h)` of what `render` with
+/// these options gives: the whole image's size and the part rendered. Checks the
+/// options as `render` does (`ValueError`), without rendering.
+#[pyfunction]
+#[pyo3(signature = (scene, *, width=None, height=None, spp=None, depth=None, seed=None,
+    quality=None, region=None, tile=None, threads=None, reference=false))]
+#[allow(clippy::too_many_arguments)]
+fn plan(
+    scene: &PyScene,
+    width: Option<u32>,
+    height: Option<u32>,
+    spp: Option<u32>,
+    depth: Option<u32>,
+    seed: Option<u64>,
+    quality: Option<String>,
+    region: Option<Rect>,
+    tile: Option<(u32, u32)>,
+    threads: Option<usize>,
+    reference: bool,
+) -> PyResult<((u32, u32), Rect)> {
+    let options =
+        options!(width, height, spp, depth, seed, quality, region, tile, threads, reference);
+    let settings = options.settings(&scene.inner)?;
+    let a = settings.area();
+    Ok((
+        (settings.width, settings.height),
+        (a.x, a.y, a.width, a.height),
+    ))
+}
+
+/// Writes an image file atomically, format by extension, as the command line does:
+/// a `uint8` array `(h, w, 3)` to `.png .ppm .bmp .jpg`; a `float32` array (linear
+/// values) to any of those or `.exr`. `ppm_binary` writes P6 instead of P3.
+#[pyfunction]
+#[pyo3(signature = (path, image, *, ppm_binary=false))]
+fn write_image(
+    py: Python<'_>,
+    path: PathBuf,
+    image: &Bound<'_, PyAny>,
+    ppm_binary: bool,
+) -> PyResult<()> {
+    let format =
+        Format::from_path(&path, ppm_binary).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let shape_error = || PyValueError::new_err("expected an array of shape (height, width, 3)");
+    let io = |e: image_io::SaveError| PyErr::new::<pyo3::exceptions::PyOSError, _>(e.to_string());
+    if let Ok(bytes) = image.extract::<PyReadonlyArray3<u8>>() {
+        let shape = bytes.shape();
+        if shape[2] != 3 {
+            return Err(shape_error());
+        }
+        let (h, w) = (shape[0] as u32, shape[1] as u32);
+        let raw = bytes
+            .as_slice()
+            .map(<[u8]>::to_vec)
+            .unwrap_or_else(|_| bytes.as_array().iter().copied().collect());
+        let rgb = image::RgbImage::from_raw(w, h, raw).ok_or_else(shape_error)?;
+        if format == Format::Exr {
+            return Err(PyValueError::new_err(
+                "EXR holds linear values: pass a float32 array",
+            ));
+        }
+        return py
+            .detach(|| {
+                let mut out = Vec::new();
+                image_io::encode_rgb8(&rgb, format, &mut out).map_err(|e| image_io::SaveError {
+                    path: path.display().to_string(),
+                    message: format!("cannot encode: {e}"),
+                })?;
+                image_io::write_atomically(&path, &out)
+            })
+            .map_err(io);
+    }
+    let values: PyReadonlyArray3<f32> = image.extract().map_err(|_| {
+        PyValueError::new_err("expected a uint8 or float32 array of shape (height, width, 3)")
+    })?;
+    let shape = values.shape();
+    if shape[2] != 3 {
+        return Err(shape_error());
+    }
+    let (h, w) = (shape[0] as u32, shape[1] as u32);
+    let raw: Vec<f32> = values.as_array().iter().copied().collect();
+    let top_down = image::Rgb32FImage::from_raw(w, h, raw).ok_or_else(shape_error)?;
+    let frame = image_io::parts::frame_of(&top_down);
+    py.detach(|| image_io::save(&frame, &path, format))
+        .map_err(io)
+}
+
+/// The rectangle `(x, y, w, h)` of tile `index` of `count` tiles over a
+/// `width`×`height` image, as `--tile index/count` renders it.
+#[pyfunction]
+fn tile_region(index: u32, count: u32, width: u32, height: u32) -> PyResult<Rect> {
+    let r = Tile { index, count }.region(width, height).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "tile {index}/{count} does not exist in a {width}x{height} image"
+        ))
+    })?;
+    Ok((r.x, r.y, r.width, r.height))
+}
+
+/// The rendering core of `whitted`.
+#[pymodule]
+fn _whitted(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("SceneError", m.py().get_type::<SceneError>())?;
+    m.add_class::<PyScene>()?;
+    m.add_function(wrap_pyfunction!(load_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(parse_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(hw3_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(render_linear, m)?)?;
+    m.add_function(wrap_pyfunction!(plan, m)?)?;
+    m.add_function(wrap_pyfunction!(write_image, m)?)?;
+    m.add_function(wrap_pyfunction!(tile_region, m)?)?;
+    m.add_function(wrap_pyfunction!(_scene_from_toml, m)?)?;
+    Ok(())
+}
