@@ -4,6 +4,7 @@
 #![forbid(unsafe_code)]
 
 use std::path::PathBuf;
+use std::sync::mpsc::RecvTimeoutError;
 use std::time::Duration;
 
 use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray3, PyUntypedArrayMethods};
@@ -187,16 +188,24 @@ macro_rules! options {
     };
 }
 
-/// Renders with the GIL released, polling for Ctrl-C: a signal cancels the render
-/// (within a row of pixels) and raises `KeyboardInterrupt`.
+/// Renders with the GIL released, waking every 20 ms to look for Ctrl-C: a signal
+/// cancels the render (within a row of pixels) and raises `KeyboardInterrupt`. The
+/// render's end wakes the wait at once.
 fn render_frame(py: Python<'_>, scene: &whitted::Scene, settings: &Settings) -> PyResult<Frame> {
     let control = RenderControl::default();
     let outcome = py.detach(|| {
         std::thread::scope(|s| {
-            let job = s.spawn(|| whitted::render(scene, settings, &control));
+            let (done, finished) = std::sync::mpsc::channel();
+            let control = &control;
+            let job = s.spawn(move || {
+                let result = whitted::render(scene, settings, control);
+                let _ = done.send(());
+                result
+            });
             loop {
-                if job.is_finished() {
-                    return Ok(job.join());
+                match finished.recv_timeout(Duration::from_millis(20)) {
+                    Ok(()) | Err(RecvTimeoutError::Disconnected) => return Ok(job.join()),
+                    Err(RecvTimeoutError::Timeout) => {}
                 }
                 // Python's signal handler only sets a flag; it is read with the GIL.
                 if let Err(interrupt) = Python::attach(|py| py.check_signals()) {
@@ -204,7 +213,6 @@ fn render_frame(py: Python<'_>, scene: &whitted::Scene, settings: &Settings) -> 
                     let _ = job.join();
                     return Err(interrupt);
                 }
-                std::thread::sleep(Duration::from_millis(10));
             }
         })
     })?;
