@@ -9,9 +9,9 @@ use std::time::Duration;
 
 use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{PyDict, PyTuple};
 
 use whitted::image_io::{self, Format};
 use whitted::render::{Frame, RenderControl};
@@ -120,7 +120,7 @@ fn hw3_scene(seed: u64) -> PyScene {
 /// A rectangle `(x, y, width, height)`, origin top-left.
 type Rect = (u32, u32, u32, u32);
 
-/// The keyword options of `render` and `render_linear`, as the command line's.
+/// The keyword options of `render`, `render_linear` and `plan`, as the command line's.
 #[derive(Default)]
 struct Options {
     width: Option<u32>,
@@ -135,7 +135,43 @@ struct Options {
     reference: bool,
 }
 
+/// The keywords [`Options`] knows.
+const KEYWORDS: &str = "width, height, spp, depth, seed, quality, region, tile, threads, reference";
+
 impl Options {
+    /// The options of a call's keyword arguments; `None` values count as not given,
+    /// an unknown keyword is a `TypeError` as in any Python function.
+    fn from_kwargs(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Options> {
+        let mut o = Options::default();
+        let Some(kwargs) = kwargs else {
+            return Ok(o);
+        };
+        for (key, value) in kwargs.iter() {
+            let key: String = key.extract()?;
+            if value.is_none() {
+                continue;
+            }
+            match key.as_str() {
+                "width" => o.width = Some(value.extract()?),
+                "height" => o.height = Some(value.extract()?),
+                "spp" => o.spp = Some(value.extract()?),
+                "depth" => o.depth = Some(value.extract()?),
+                "seed" => o.seed = Some(value.extract()?),
+                "quality" => o.quality = Some(value.extract()?),
+                "region" => o.region = Some(value.extract()?),
+                "tile" => o.tile = Some(value.extract()?),
+                "threads" => o.threads = Some(value.extract()?),
+                "reference" => o.reference = value.extract()?,
+                other => {
+                    return Err(PyTypeError::new_err(format!(
+                        "unexpected keyword argument '{other}' (expected {KEYWORDS})"
+                    )))
+                }
+            }
+        }
+        Ok(o)
+    }
+
     /// The settings these options make of `scene`'s, checked.
     fn settings(&self, scene: &whitted::Scene) -> PyResult<Settings> {
         let quality = match &self.quality {
@@ -168,24 +204,6 @@ impl Options {
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
         Ok(settings)
     }
-}
-
-macro_rules! options {
-    ($width:ident, $height:ident, $spp:ident, $depth:ident, $seed:ident, $quality:ident,
-     $region:ident, $tile:ident, $threads:ident, $reference:ident) => {
-        Options {
-            width: $width,
-            height: $height,
-            spp: $spp,
-            depth: $depth,
-            seed: $seed,
-            quality: $quality,
-            region: $region,
-            tile: $tile,
-            threads: $threads,
-            reference: $reference,
-        }
-    };
 }
 
 /// Renders with the GIL released, waking every 20 ms to look for Ctrl-C: a signal
@@ -225,27 +243,16 @@ fn render_frame(py: Python<'_>, scene: &whitted::Scene, settings: &Settings) -> 
 
 /// Renders `scene` to 8-bit RGB: a numpy array `(height, width, 3)` of `uint8`, top
 /// row first, the bytes `whitted render -o x.png` writes with the same options.
+/// Keywords: width, height, spp, depth, seed, quality, region=(x, y, w, h),
+/// tile=(i, n), threads, reference.
 #[pyfunction]
-#[pyo3(signature = (scene, *, width=None, height=None, spp=None, depth=None, seed=None,
-    quality=None, region=None, tile=None, threads=None, reference=false))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (scene, **options))]
 fn render<'py>(
     py: Python<'py>,
     scene: &PyScene,
-    width: Option<u32>,
-    height: Option<u32>,
-    spp: Option<u32>,
-    depth: Option<u32>,
-    seed: Option<u64>,
-    quality: Option<String>,
-    region: Option<Rect>,
-    tile: Option<(u32, u32)>,
-    threads: Option<usize>,
-    reference: bool,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray3<u8>>> {
-    let options =
-        options!(width, height, spp, depth, seed, quality, region, tile, threads, reference);
-    let settings = options.settings(&scene.inner)?;
+    let settings = Options::from_kwargs(options)?.settings(&scene.inner)?;
     let frame = render_frame(py, &scene.inner, &settings)?;
     let (w, h) = (frame.width as usize, frame.height as usize);
     let bytes = image_io::to_rgb8(&frame).into_raw();
@@ -254,27 +261,15 @@ fn render<'py>(
 
 /// Renders `scene` to linear RGB: a numpy array `(height, width, 3)` of `float32`, top
 /// row first, the values `whitted render -o x.exr` writes with the same options.
+/// Keywords as `render`'s.
 #[pyfunction]
-#[pyo3(signature = (scene, *, width=None, height=None, spp=None, depth=None, seed=None,
-    quality=None, region=None, tile=None, threads=None, reference=false))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (scene, **options))]
 fn render_linear<'py>(
     py: Python<'py>,
     scene: &PyScene,
-    width: Option<u32>,
-    height: Option<u32>,
-    spp: Option<u32>,
-    depth: Option<u32>,
-    seed: Option<u64>,
-    quality: Option<String>,
-    region: Option<Rect>,
-    tile: Option<(u32, u32)>,
-    threads: Option<usize>,
-    reference: bool,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let options =
-        options!(width, height, spp, depth, seed, quality, region, tile, threads, reference);
-    let settings = options.settings(&scene.inner)?;
+    let settings = Options::from_kwargs(options)?.settings(&scene.inner)?;
     let frame = render_frame(py, &scene.inner, &settings)?;
     let (w, h) = (frame.width as usize, frame.height as usize);
     let values = image_io::to_rgb32f(&frame).into_raw();
@@ -283,27 +278,11 @@ fn render_linear<'py>(
 
 /// The size `(width, height)` and the rectangle `(x, y, w, h)` of what `render` with
 /// these options gives: the whole image's size and the part rendered. Checks the
-/// options as `render` does (`ValueError`), without rendering.
+/// options as `render` does (`ValueError`), without rendering. Keywords as `render`'s.
 #[pyfunction]
-#[pyo3(signature = (scene, *, width=None, height=None, spp=None, depth=None, seed=None,
-    quality=None, region=None, tile=None, threads=None, reference=false))]
-#[allow(clippy::too_many_arguments)]
-fn plan(
-    scene: &PyScene,
-    width: Option<u32>,
-    height: Option<u32>,
-    spp: Option<u32>,
-    depth: Option<u32>,
-    seed: Option<u64>,
-    quality: Option<String>,
-    region: Option<Rect>,
-    tile: Option<(u32, u32)>,
-    threads: Option<usize>,
-    reference: bool,
-) -> PyResult<((u32, u32), Rect)> {
-    let options =
-        options!(width, height, spp, depth, seed, quality, region, tile, threads, reference);
-    let settings = options.settings(&scene.inner)?;
+#[pyo3(signature = (scene, **options))]
+fn plan(scene: &PyScene, options: Option<&Bound<'_, PyDict>>) -> PyResult<((u32, u32), Rect)> {
+    let settings = Options::from_kwargs(options)?.settings(&scene.inner)?;
     let a = settings.area();
     Ok((
         (settings.width, settings.height),

@@ -112,6 +112,10 @@ def test_wrong_types_raise_type_error():
         whitted.render(whitted.hw3_scene(), width="wide")
     with pytest.raises(OverflowError):
         whitted.render(whitted.hw3_scene(), width=-5)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'sppp'"):
+        whitted.render(whitted.hw3_scene(), sppp=4)
+    # None means "not given", as in the signatures.
+    assert whitted.plan(whitted.hw3_scene(), width=None, region=None) == ((1280, 720), (0, 0, 1280, 720))
 
 
 def test_scenes_pickle_as_their_text():
