@@ -3,15 +3,12 @@
 //! file's line and column, or the field); and a failed write leaves no file behind.
 #![cfg(all(feature = "cli", feature = "viewer"))]
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn whitted(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .args(args)
-        .output()
-        .expect("run whitted")
-}
+use common::run as whitted;
 
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()

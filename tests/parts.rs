@@ -3,15 +3,12 @@
 //! render, or refuses with one line and writes nothing.
 #![cfg(all(feature = "cli", feature = "viewer"))]
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn whitted(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .args(args)
-        .output()
-        .expect("run whitted")
-}
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use common::run as whitted;
 
 fn ok(args: &[&str]) {
     let out = whitted(args);
