@@ -554,3 +554,35 @@ fn delays_follow_the_frame_rate() {
     assert_eq!(image_io::apng_delay(24.0), (1, 24));
     assert_eq!(image_io::apng_delay(29.97), (334, 10_000));
 }
+
+#[test]
+fn the_committed_turntable_gif_is_the_turntable_scene() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = Scene::load(&root.join("assets/scenes/turntable.toml")).unwrap();
+    let animation = scene.animation.clone().unwrap();
+    assert_eq!(animation.motion, Motion::Orbit { degrees: 360.0 });
+    let file = BufReader::new(std::fs::File::open(root.join("assets/turntable.gif")).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap();
+    assert_eq!(frames.len() as u32, animation.frames);
+    let settings = scene.settings();
+    assert_eq!(
+        frames[0].buffer().dimensions(),
+        (settings.width, settings.height)
+    );
+    // Frame 0 of the file is the still scene's image, within the palette's error.
+    let mut still = scene.clone();
+    still.animation = None;
+    let (frame, _) = render::render(&still, &settings, &RenderControl::default()).unwrap();
+    let expected = image_io::to_rgb8(&frame);
+    let decoded = rgb(frames.into_iter().next().unwrap());
+    let off = decoded
+        .pixels()
+        .zip(expected.pixels())
+        .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 48))
+        .count();
+    assert!(off * 100 < expected.len() / 3, "{off} pixels far off");
+}
