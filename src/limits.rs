@@ -20,3 +20,5 @@ pub const MAX_FILE_BYTES: u64 = 1 << 26;
 /// the text); larger files must end in a run of `[[sphere]]` tables, which is parsed a
 /// batch of tables at a time.
 pub const MAX_WHOLE_PARSE_BYTES: u64 = 1 << 24;
+/// Frames of an animation.
+pub const MAX_FRAMES: u32 = 1 << 20;

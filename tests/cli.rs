@@ -135,7 +135,7 @@ fn usage_errors_exit_2() {
         &["render", "--spp", "-1"],
         &["render", "--region", "1,2,3"],
         &["render", "--region", "0,0,0,5"],
-        &["render", "-o", "picture.gif"],
+        &["render", "-o", "picture.tiff"],
         &["render", "-o", "no-extension"],
         &["scene", "hw4"],
         &["scene", "hw3", "--seed", "x"],

@@ -87,6 +87,7 @@ fn mirrors() -> (Scene, Camera) {
         sky: Default::default(),
         lights: vec![Light::default()],
         spheres: vec![mirror(-r - 1.0), mirror(r + 1.0)],
+        animation: None,
     };
     let camera = scene.camera(16, 9).unwrap();
     (scene, camera)

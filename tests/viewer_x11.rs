@@ -482,6 +482,113 @@ fn samples_accumulate_to_the_render_at_the_target_spp() {
     assert!(status.success());
 }
 
+/// The frame number in a title `... - frame K/N - ...`, when the title ends in done.
+fn done_frame(title: &str) -> Option<u32> {
+    let rest = title.split(" - frame ").nth(1)?;
+    let k = rest.split('/').next()?.parse().ok()?;
+    title.ends_with("- done").then_some(k)
+}
+
+#[test]
+fn an_animated_scene_plays_and_steps_through_its_frames() {
+    if !x_tools_or_skip("animation playback test") {
+        return;
+    }
+    let x = XServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    // A 4-frame quarter turn at 2 frames a second (time enough for screenshots).
+    let mut scene = whitted::scene::hw3_scene(whitted::scene::HW3_DEFAULT_SEED);
+    scene.image.width = Some(320);
+    scene.image.height = Some(180);
+    scene.camera = Some(whitted::CameraSpec::LookAt {
+        look_from: glam::DVec3::new(0.0, 1.0, 1.0),
+        look_at: glam::DVec3::new(0.0, 0.0, -2.0),
+        up: glam::DVec3::Y,
+        vfov: 50.0,
+    });
+    scene.animation = Some(whitted::scene::Animation {
+        frames: 4,
+        fps: 2.0,
+        motion: whitted::scene::Motion::Orbit { degrees: 90.0 },
+    });
+    let path = dir.join("small.toml");
+    fs::write(&path, whitted::scene::to_toml(&scene)).unwrap();
+    let out = Command::new(BIN)
+        .args(["render", "small.toml", "-q", "-o", "f-%d.png"])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let numbered: Vec<RgbImage> = (0..4)
+        .map(|k| {
+            image::open(dir.join(format!("f-{k}.png")))
+                .unwrap()
+                .to_rgb8()
+        })
+        .collect();
+
+    let (mut viewer, window) = start_viewer(&x, dir, &path, "softbuffer");
+    let shows = |x: &XServer, viewer: &mut Viewer, k: u32| {
+        let title = x.wait_title(viewer, &window, |t| done_frame(t) == Some(k));
+        assert!(title.contains(" - 320x180 - frame "), "title: {title}");
+        let diff = screenshot_matching(x, &window, dir, &numbered[k as usize]);
+        assert_eq!(diff, 0, "frame {k}: {diff} pixels differ from f-{k}.png");
+    };
+    shows(&x, &mut viewer, 0);
+    // `.` steps forward, `,` back (wrapping round).
+    x.key(&window, "period");
+    shows(&x, &mut viewer, 1);
+    x.key(&window, "period");
+    shows(&x, &mut viewer, 2);
+    x.key(&window, "comma");
+    shows(&x, &mut viewer, 1);
+    x.key(&window, "comma");
+    x.key(&window, "comma");
+    shows(&x, &mut viewer, 3);
+
+    // P plays: the frames advance by themselves, each one the numbered file, until P
+    // again pauses.
+    x.key(&window, "p");
+    let mut seen = Vec::new();
+    wait_for("three frames played", || {
+        viewer.assert_running();
+        let before = done_frame(&x.title(&window));
+        let shot = x.screenshot(&window, dir, "playing.png");
+        let after = done_frame(&x.title(&window));
+        if let (Some(k), true) = (before, before == after) {
+            if seen.last() != Some(&k) {
+                assert_eq!(
+                    differing(&shot, &numbered[k as usize]),
+                    0,
+                    "frame {k} on screen differs from f-{k}.png"
+                );
+                seen.push(k);
+            }
+        }
+        (seen.len() >= 3).then_some(())
+    });
+    assert!(
+        seen.windows(2).all(|w| w[1] == (w[0] + 1) % 4),
+        "order: {seen:?}"
+    );
+    x.key(&window, "p");
+    std::thread::sleep(Duration::from_millis(700));
+    let paused = x.title(&window);
+    std::thread::sleep(Duration::from_millis(1500));
+    assert_eq!(x.title(&window), paused, "paused, the frame stays");
+
+    x.key(&window, "h");
+    viewer.wait_stdout("play or pause");
+    x.key(&window, "Escape");
+    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
+    assert!(status.success(), "stderr:\n{}", viewer.stderr());
+}
+
 /// Opens the 320×180 one-sample scene in the viewer with `env`, waits for the
 /// finished image, checks that the window shows `whitted render`'s pixels, and quits;
 /// the viewer's stderr. `None` (said loudly) without the X tools.

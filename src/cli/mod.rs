@@ -1,5 +1,6 @@
 //! The subcommands of the `whitted` binary, one module each; the library does the work.
 
+pub(crate) mod animate;
 pub(crate) mod bench;
 pub(crate) mod render;
 pub(crate) mod stitch;

@@ -14,6 +14,7 @@ use whitted::image_io::{self, Format};
 use whitted::render::{self, RenderControl};
 use whitted::settings::{Overrides, Precision, Preset, Region, Tile};
 
+use super::animate::{self, FrameOptions};
 use super::load_scene;
 
 #[derive(Args)]
@@ -21,8 +22,9 @@ pub(crate) struct RenderArgs {
     /// A scene file (TOML); default: the built-in hw3 scene.
     scene: Option<PathBuf>,
     /// Output file, format by extension: .ppm .png .bmp .jpg .exr (repeatable).
-    /// Default: output.ppm and output.png.
-    #[arg(short, long = "output", value_name = "FILE", value_parser = parse_output)]
+    /// Default: output.ppm and output.png. Animations: a pattern such as
+    /// f-%04d.png (a file per frame), or .gif or .apng (all frames in one file).
+    #[arg(short, long = "output", value_name = "FILE", value_parser = animate::parse_output)]
     output: Vec<PathBuf>,
     /// Write binary PPM (P6) instead of plain (P3).
     #[arg(long)]
@@ -63,6 +65,8 @@ pub(crate) struct RenderArgs {
     /// No progress bar and no closing line.
     #[arg(short, long)]
     quiet: bool,
+    #[command(flatten)]
+    animation: FrameOptions,
 }
 
 impl RenderArgs {
@@ -107,14 +111,19 @@ fn parse_region(text: &str) -> Result<Region, String> {
     }
 }
 
-/// An output path whose extension names a format we write (else a usage error).
-pub(crate) fn parse_output(text: &str) -> Result<PathBuf, String> {
-    let path = PathBuf::from(text);
-    Format::from_path(&path, false).map_err(|e| e.to_string())?;
-    Ok(path)
-}
-
 pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
+    let scene = load_scene(args.scene.as_deref())?;
+    if animate::wanted(&args.animation, &scene, &args.output) {
+        let opts = scene.settings().with(&args.overrides());
+        return animate::render_frames(
+            scene,
+            &opts,
+            &args.animation,
+            &args.output,
+            args.ppm_binary,
+            args.quiet,
+        );
+    }
     let outputs: Vec<PathBuf> = if args.output.is_empty() {
         vec!["output.ppm".into(), "output.png".into()]
     } else {
@@ -129,7 +138,6 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
         targets.push((path, format));
     }
 
-    let scene = load_scene(args.scene.as_deref())?;
     let opts = scene.settings().with(&args.overrides());
     opts.check()?;
 

@@ -13,7 +13,7 @@ use whitted::image_io::{self, Format};
 pub(crate) struct StitchArgs {
     /// The whole image, format by extension: .ppm .png .bmp .jpg from PNG parts; any,
     /// .exr included, from EXR parts.
-    #[arg(short, long = "output", value_name = "FILE", value_parser = super::render::parse_output)]
+    #[arg(short, long = "output", value_name = "FILE", value_parser = parse_image_path)]
     output: PathBuf,
     /// Write binary PPM (P6) instead of plain (P3).
     #[arg(long)]
@@ -21,6 +21,13 @@ pub(crate) struct StitchArgs {
     /// The parts (PNG or EXR files written with --tile or --region).
     #[arg(required = true, value_name = "PART")]
     parts: Vec<PathBuf>,
+}
+
+/// A path whose extension names a still format (else a usage error).
+fn parse_image_path(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    Format::from_path(&path, false).map_err(|e| e.to_string())?;
+    Ok(path)
 }
 
 pub(crate) fn stitch_command(args: StitchArgs) -> anyhow::Result<()> {

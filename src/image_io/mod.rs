@@ -2,6 +2,8 @@
 //! bottom-up frame is flipped to the top-down order of files, once. Every file is
 //! written whole or not at all: into a temporary file beside the target, then renamed.
 
+mod animated;
+
 use std::io::{Cursor, Write};
 use std::path::{Path, PathBuf};
 
@@ -14,6 +16,7 @@ use image::{ExtendedColorType, ImageEncoder, Rgb32FImage, RgbImage};
 use crate::render::Frame;
 
 pub mod parts;
+pub use animated::{apng_delay, gif_delay_centiseconds, AnimatedFormat, AnimatedWriter};
 
 /// The file formats `whitted` writes, chosen by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -13,6 +13,7 @@ pub(crate) mod film;
 mod frame;
 pub(crate) mod progressive;
 mod resolve;
+mod sequence;
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
@@ -34,6 +35,7 @@ pub use adaptive::first_pass_samples;
 pub use frame::Frame;
 pub use progressive::{accumulate, accumulate_first};
 pub use resolve::{mend_non_finite, pixel_value, pixel_values, resolve};
+pub use sequence::Sequence;
 
 /// Why a render did not finish.
 #[derive(Debug, thiserror::Error)]

@@ -112,6 +112,7 @@ pub fn hw3_scene(seed: u64) -> Scene {
         sky: Sky::default(),
         lights: vec![Light::default()],
         spheres,
+        animation: None,
     }
 }
 

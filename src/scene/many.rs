@@ -80,6 +80,7 @@ pub fn many_scene(n: usize) -> Scene {
             intensity: DVec3::ONE,
         }],
         spheres,
+        animation: None,
     }
 }
 

@@ -2,6 +2,7 @@
 //! as the scene file gave them. Loading ([`load`]) validates everything, so the
 //! renderers downstream may assume a scene is sane. This module never renders.
 
+mod animation;
 mod hw3;
 mod load;
 mod many;
@@ -12,6 +13,7 @@ use glam::DVec3;
 use crate::camera::{Camera, CameraError, CameraSpec};
 use crate::settings::{Overrides, Settings};
 
+pub use animation::{look_at_form, Animation, CameraKey, Motion};
 pub use hw3::{hw3_scene, hw3_toml, HW3_DEFAULT_SEED};
 pub use many::many_scene;
 pub use write::to_toml;
@@ -101,6 +103,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// The balls.
     pub spheres: Vec<Sphere>,
+    /// `None`: one still frame (the file has no `[animation]` table).
+    pub animation: Option<Animation>,
 }
 
 impl Scene {
@@ -113,6 +117,33 @@ impl Scene {
                 CameraSpec::assignment_frame()
             }
             None => CameraSpec::assignment_look_at(),
+        }
+    }
+
+    /// Frames of the scene's animation (1 for a still scene).
+    pub fn frames(&self) -> u32 {
+        self.animation.as_ref().map_or(1, |a| a.frames)
+    }
+
+    /// The camera spec of frame `k` at `width`×`height`: [`Scene::camera_spec`] moved
+    /// by the animation ([`Animation::camera_at`]). Every renderer of a frame (the
+    /// command line, the viewer, Python) takes its camera from here.
+    pub fn frame_camera_spec(&self, k: u32, width: u32, height: u32) -> CameraSpec {
+        let still = self.camera_spec(width, height);
+        match &self.animation {
+            None => still,
+            Some(animation) => animation.camera_at(&still, k),
+        }
+    }
+
+    /// Frame `k` at `width`×`height` as a still scene: this scene with the camera of
+    /// that frame and no animation. Rendered like any scene, it gives the frame's
+    /// pixels.
+    pub fn frame(&self, k: u32, width: u32, height: u32) -> Scene {
+        Scene {
+            camera: Some(self.frame_camera_spec(k, width, height)),
+            animation: None,
+            ..self.clone()
         }
     }
 

@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use super::Scene;
+use super::{Animation, Motion, Scene};
 use crate::camera::CameraSpec;
 
 #[derive(Serialize)]
@@ -11,6 +11,8 @@ struct OutScene {
     camera: Option<OutCamera>,
     image: OutImage,
     sky: OutSky,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    animation: Option<OutAnimation>,
     light: Vec<OutLight>,
     sphere: Vec<OutSphere>,
 }
@@ -46,6 +48,54 @@ struct OutImage {
     seed: Option<u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     quality: Option<&'static str>,
+}
+
+#[derive(Serialize)]
+struct OutAnimation {
+    frames: u32,
+    fps: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    orbit: Option<f64>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    key: Vec<OutKey>,
+}
+
+#[derive(Serialize)]
+struct OutKey {
+    frame: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    look_from: Option<[f64; 3]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    look_at: Option<[f64; 3]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    up: Option<[f64; 3]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    vfov: Option<f64>,
+}
+
+fn out_animation(a: &Animation) -> OutAnimation {
+    let (orbit, key) = match &a.motion {
+        Motion::Still => (None, Vec::new()),
+        Motion::Orbit { degrees } => (Some(*degrees), Vec::new()),
+        Motion::Keys(keys) => (
+            None,
+            keys.iter()
+                .map(|k| OutKey {
+                    frame: k.frame,
+                    look_from: k.look_from.map(|v| v.to_array()),
+                    look_at: k.look_at.map(|v| v.to_array()),
+                    up: k.up.map(|v| v.to_array()),
+                    vfov: k.vfov,
+                })
+                .collect(),
+        ),
+    };
+    OutAnimation {
+        frames: a.frames,
+        fps: a.fps,
+        orbit,
+        key,
+    }
 }
 
 #[derive(Serialize)]
@@ -109,6 +159,7 @@ pub fn to_toml(scene: &Scene) -> String {
             down: scene.sky.down.to_array(),
             up: scene.sky.up.to_array(),
         },
+        animation: scene.animation.as_ref().map(out_animation),
         light: scene
             .lights
             .iter()

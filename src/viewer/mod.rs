@@ -21,7 +21,7 @@ pub mod worker;
 use std::path::Path;
 use std::sync::Arc;
 use std::thread::JoinHandle;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail};
 use winit::application::ApplicationHandler;
@@ -111,6 +111,17 @@ struct App {
     /// Pixels per second of the last one-sample pass, to size the next preview.
     speed: f64,
     error: Option<anyhow::Error>,
+    /// The animation frame rendered (0 for a still scene).
+    frame: u32,
+    /// The frame of the current job, and of what is on screen.
+    job_frame: u32,
+    shown_frame: u32,
+    /// `P`: the frames advance by themselves.
+    playing: bool,
+    /// When the current job was submitted: the next frame is due 1/fps after it.
+    job_started: Instant,
+    /// Playing, the current frame is complete and the next is due at this time.
+    next_frame_at: Option<Instant>,
 }
 
 impl App {
@@ -151,6 +162,12 @@ impl App {
             throttle: schedule::Throttle::default(),
             speed: f64::NAN,
             error: None,
+            frame: 0,
+            job_frame: 0,
+            shown_frame: 0,
+            playing: false,
+            job_started: started,
+            next_frame_at: None,
         }
     }
 
@@ -180,8 +197,16 @@ impl App {
         self.generation += 1;
         self.throttle.started();
         let mut scene = (*self.scene).clone();
-        scene.camera = Some(self.camera.spec(&self.scene, w, h));
+        let still = self.camera.spec(&self.scene, w, h);
+        // The animation moves the scene's camera, not one the user has edited.
+        scene.camera = Some(match &self.scene.animation {
+            Some(animation) if !self.camera.is_edited() => animation.camera_at(&still, self.frame),
+            _ => still,
+        });
         self.job_scene = Arc::new(scene);
+        self.job_frame = self.frame;
+        self.job_started = Instant::now();
+        self.next_frame_at = None;
         self.job_size = (w, h);
         self.progress = Progress::Rendering;
         let factor = schedule::preview_factor(w, h, self.speed);
@@ -193,8 +218,55 @@ impl App {
     fn update_title(&self) {
         if let Some(window) = &self.window {
             let (w, h) = self.job_size;
-            window.set_title(&status::title(&self.scene.name, w, h, &self.progress));
+            let frame = self.frame_label(self.job_frame);
+            let title = status::title_of_frame(&self.scene.name, w, h, frame, &self.progress);
+            window.set_title(&title);
         }
+    }
+
+    /// `(k, frames)` for the title of an animated scene.
+    fn frame_label(&self, k: u32) -> Option<(u32, u32)> {
+        self.scene.animation.as_ref().map(|a| (k, a.frames))
+    }
+
+    /// Shows frame `k` (wrapping around the animation).
+    fn go_to_frame(&mut self, k: i64) {
+        let frames = i64::from(self.scene.frames());
+        self.frame = k.rem_euclid(frames) as u32;
+        self.submit();
+    }
+
+    /// `,` and `.`: one frame back or forward; stepping pauses.
+    fn step(&mut self, by: i64) {
+        if self.scene.animation.is_some() {
+            self.playing = false;
+            self.go_to_frame(i64::from(self.frame) + by);
+        }
+    }
+
+    /// `P`: plays from the frame on screen, or pauses.
+    fn toggle_play(&mut self) {
+        if self.scene.animation.is_none() {
+            println!("this scene has no animation to play");
+            return;
+        }
+        self.playing = !self.playing;
+        self.next_frame_at = None;
+        if self.playing
+            && matches!(self.progress, Progress::Samples { samples, target, .. } if samples >= target)
+        {
+            self.go_to_frame(i64::from(self.frame) + 1);
+        }
+    }
+
+    /// Playing, once a frame is complete: the next is due 1/fps after this one
+    /// started, or at once if rendering took longer.
+    fn schedule_next_frame(&mut self) {
+        let Some(animation) = &self.scene.animation else {
+            return;
+        };
+        let period = Duration::from_secs_f64(1.0 / animation.fps);
+        self.next_frame_at = Some(self.job_started + period);
     }
 
     fn camera_action(&mut self, action: Action) {
@@ -224,6 +296,9 @@ impl App {
                     self.submit();
                 }
                 "h" => println!("{}", status::HELP),
+                "p" if !event.repeat => self.toggle_play(),
+                "," => self.step(-1),
+                "." => self.step(1),
                 _ => {}
             },
             _ => {}
@@ -237,10 +312,13 @@ impl App {
             return;
         };
         let frame = Arc::clone(&shown.frame);
-        let what = format!(
+        let mut what = format!(
             "{}x{}, {}/{} spp",
             frame.width, frame.height, shown.samples, shown.target
         );
+        if let Some((k, n)) = self.frame_label(self.shown_frame) {
+            what += &format!(", frame {k}/{n}");
+        }
         let (png, ppm) = self
             .numbering
             .next(Path::new(""), &self.stem, |p| p.exists());
@@ -291,8 +369,13 @@ impl App {
                 seconds: shown.pass_seconds,
             }
         };
+        let complete = shown.done;
         self.shown = Some((shown, Arc::clone(&self.job_scene)));
+        self.shown_frame = self.job_frame;
         self.fresh = true;
+        if complete && self.playing {
+            self.schedule_next_frame();
+        }
         if let Some(window) = &self.window {
             window.request_redraw();
         }
@@ -356,13 +439,31 @@ impl App {
 }
 
 impl ApplicationHandler<Report> for App {
+    /// Playing: waits (without blocking the loop) until the next frame is due.
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        match self.next_frame_at {
+            Some(due) if Instant::now() >= due => {
+                self.go_to_frame(i64::from(self.frame) + 1);
+                event_loop.set_control_flow(ControlFlow::Wait);
+            }
+            Some(due) => event_loop.set_control_flow(ControlFlow::WaitUntil(due)),
+            None => event_loop.set_control_flow(ControlFlow::Wait),
+        }
+    }
+
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
         if self.window.is_some() {
             return;
         }
         let (w, h) = (self.scene.settings().width, self.scene.settings().height);
         let attributes = Window::default_attributes()
-            .with_title(status::title(&self.scene.name, w, h, &Progress::Rendering))
+            .with_title(status::title_of_frame(
+                &self.scene.name,
+                w,
+                h,
+                self.frame_label(0),
+                &Progress::Rendering,
+            ))
             .with_inner_size(PhysicalSize::new(w, h));
         let window = match event_loop.create_window(attributes) {
             Ok(window) => Arc::new(window),

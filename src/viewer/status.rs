@@ -22,6 +22,19 @@ pub enum Progress {
 /// The window title: `whitted - SCENE - WxH - PROGRESS`. It ends in `- done` exactly
 /// when every sample of the current view is on screen (the tests wait for that).
 pub fn title(scene: &str, width: u32, height: u32, progress: &Progress) -> String {
+    title_of_frame(scene, width, height, None, progress)
+}
+
+/// The title of frame `k` of `n` of an animation (`None`: a still scene):
+/// `whitted - SCENE - WxH - frame K/N - PROGRESS`, `K` counted from 0 as in the
+/// numbered files of `whitted render`.
+pub fn title_of_frame(
+    scene: &str,
+    width: u32,
+    height: u32,
+    frame: Option<(u32, u32)>,
+    progress: &Progress,
+) -> String {
     let ms = |s: f64| s * 1000.0;
     let state = match *progress {
         Progress::Rendering => "rendering".to_string(),
@@ -36,7 +49,10 @@ pub fn title(scene: &str, width: u32, height: u32, progress: &Progress) -> Strin
         }
         Progress::Failed => "render failed".to_string(),
     };
-    format!("whitted - {scene} - {width}x{height} - {state}")
+    match frame {
+        None => format!("whitted - {scene} - {width}x{height} - {state}"),
+        Some((k, n)) => format!("whitted - {scene} - {width}x{height} - frame {k}/{n} - {state}"),
+    }
 }
 
 pub const HELP: &str = "\
@@ -49,6 +65,10 @@ whitted viewer keys:
   mouse wheel        zoom (field of view)
   click              inspect a pixel: its ray tree is printed
   R                  reset the camera
+  P                  play or pause an animated scene (at its fps, or as fast as
+                     the frames render)
+  , .                step one frame back, forward (an edited camera stays put
+                     until R)
   H                  print this list";
 
 /// Whether `WHITTED_STATS` asks for timing lines.
@@ -92,6 +112,23 @@ mod tests {
             let t = title("x", 1, 1, &p);
             assert!(t.starts_with("whitted - x - 1x1 - ") && !t.contains("done"));
         }
+    }
+
+    #[test]
+    fn an_animated_scene_shows_its_frame_number() {
+        let done = Progress::Samples {
+            samples: 1,
+            target: 1,
+            seconds: 0.002,
+        };
+        assert_eq!(
+            title_of_frame("spin", 64, 36, Some((3, 12)), &done),
+            "whitted - spin - 64x36 - frame 3/12 - 1/1 spp - 2.0 ms - done"
+        );
+        assert_eq!(
+            title_of_frame("spin", 64, 36, None, &done),
+            title("spin", 64, 36, &done)
+        );
     }
 
     #[test]

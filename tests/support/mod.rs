@@ -156,6 +156,7 @@ fn tiny(dist: f64, seed: u64) -> Scene {
             intensity: DVec3::ONE,
         }],
         spheres,
+        animation: None,
     }
 }
 

@@ -19,6 +19,7 @@ pub(super) struct FileScene {
     pub(super) sky: Option<FileSky>,
     pub(super) light: Option<Bounded<FileLight, LightLimit>>,
     pub(super) sphere: Option<Bounded<FileSphere, SphereLimit>>,
+    pub(super) animation: Option<Spanned<FileAnimation>>,
 }
 
 /// A batch of `[[sphere]]` tables of a run (see [`SphereRun`]) parsed on its own.
@@ -128,4 +129,23 @@ pub(super) struct FileSphere {
     pub(super) reflect: Option<Num>,
     pub(super) transmit: Option<Num>,
     pub(super) ior: Option<Num>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FileAnimation {
+    pub(super) frames: Option<Int>,
+    pub(super) fps: Option<Num>,
+    pub(super) orbit: Option<Num>,
+    pub(super) key: Option<Vec<Spanned<FileKey>>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FileKey {
+    pub(super) frame: Int,
+    pub(super) look_from: Option<V3>,
+    pub(super) look_at: Option<V3>,
+    pub(super) up: Option<V3>,
+    pub(super) vfov: Option<Num>,
 }

@@ -5,10 +5,10 @@ use glam::DVec3;
 use toml::Spanned;
 
 use super::messages::Locator;
-use super::schema::{FileCamera, FileScene, FileSphere, Num, V3};
+use super::schema::{FileAnimation, FileCamera, FileScene, FileSphere, Num, V3};
 use crate::camera::CameraSpec;
 use crate::limits;
-use crate::scene::{Light, Scene, SceneError, Sky, Sphere};
+use crate::scene::{Animation, CameraKey, Light, Motion, Scene, SceneError, Sky, Sphere};
 use crate::settings::{Overrides, Preset, Settings, UnknownPreset};
 
 /// Everything but the spheres, validated.
@@ -136,6 +136,11 @@ pub(super) fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneErr
         }
     };
 
+    let animation = match &file.animation {
+        None => None,
+        Some(a) => Some(animation(at, a, camera)?),
+    };
+
     Ok(Scene {
         name: "scene".into(),
         camera,
@@ -143,6 +148,7 @@ pub(super) fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneErr
         sky,
         lights,
         spheres: Vec::new(),
+        animation,
     })
 }
 
@@ -292,4 +298,115 @@ fn camera(at: &Locator, c: &Spanned<FileCamera>) -> Result<CameraSpec, SceneErro
     spec.check()
         .map_err(|e| at.at(c.span(), format!("camera: {e}")))?;
     Ok(spec)
+}
+
+/// The `[animation]` table, with every frame's camera checked (`camera`: the scene's).
+fn animation(
+    at: &Locator,
+    a: &Spanned<FileAnimation>,
+    camera: Option<CameraSpec>,
+) -> Result<Animation, SceneError> {
+    let file = a.get_ref();
+    let mut animation = Animation::default();
+    if let Some(v) = &file.frames {
+        let n = *v.get_ref();
+        let max = i64::from(limits::MAX_FRAMES);
+        if !(1..=max).contains(&n) {
+            return Err(at.at(
+                v.span(),
+                format!("animation.frames = {n} is out of range: expected 1 to {max}"),
+            ));
+        }
+        animation.frames = n as u32;
+    }
+    if let Some(v) = &file.fps {
+        let fps = number(at, v, &"animation.fps")?;
+        if !(fps > 0.0 && fps <= Animation::MAX_FPS) {
+            return Err(at.at(
+                v.span(),
+                format!(
+                    "animation.fps = {fps} is out of range: expected more than 0, at most {}",
+                    Animation::MAX_FPS
+                ),
+            ));
+        }
+        animation.fps = fps;
+    }
+    match (&file.orbit, &file.key) {
+        (Some(orbit), Some(_)) => {
+            return Err(at.at(
+                orbit.span(),
+                "animation: give either orbit or [[animation.key]] tables, not both",
+            ));
+        }
+        (Some(orbit), None) => {
+            animation.motion = Motion::Orbit {
+                degrees: number(at, orbit, &"animation.orbit")?,
+            };
+        }
+        (None, Some(keys)) => {
+            let mut list: Vec<CameraKey> = Vec::with_capacity(keys.len());
+            for (k, spanned) in keys.iter().enumerate() {
+                let key = spanned.get_ref();
+                let what = |name: &str| format!("animation key {}: {name}", k + 1);
+                let frame = *key.frame.get_ref();
+                let max = i64::from(limits::MAX_FRAMES);
+                if !(0..max).contains(&frame) {
+                    return Err(at.at(
+                        key.frame.span(),
+                        format!(
+                            "{} = {frame} is out of range: expected 0 to {}",
+                            what("frame"),
+                            max - 1
+                        ),
+                    ));
+                }
+                let frame = frame as u32;
+                if let Some(previous) = list.last().filter(|p| p.frame >= frame) {
+                    return Err(at.at(
+                        key.frame.span(),
+                        format!(
+                            "{} = {frame} is not after the previous key's frame {}: keys go in increasing frame order",
+                            what("frame"),
+                            previous.frame
+                        ),
+                    ));
+                }
+                let v3 = |v: &Option<V3>, name: &str| match v {
+                    None => Ok(None),
+                    Some(v) => finite(at, v, &what(name)).map(Some),
+                };
+                list.push(CameraKey {
+                    frame,
+                    look_from: v3(&key.look_from, "look_from")?,
+                    look_at: v3(&key.look_at, "look_at")?,
+                    up: v3(&key.up, "up")?,
+                    vfov: match &key.vfov {
+                        None => None,
+                        Some(v) => Some(number(at, v, &what("vfov"))?),
+                    },
+                });
+            }
+            // No keys (`key = []`) is no motion.
+            if !list.is_empty() {
+                animation.motion = Motion::Keys(list);
+            }
+        }
+        (None, None) => {}
+    }
+    // Every frame's camera up to the last key (after it the camera holds): keys may
+    // meet in a degenerate camera (the eye on the look-at point) between two good
+    // ones. A turntable turns a good camera rigidly, which keeps it good.
+    let still = camera.unwrap_or_else(CameraSpec::assignment_look_at);
+    let last = match &animation.motion {
+        Motion::Keys(keys) => keys.last().map_or(0, |key| key.frame),
+        _ => 0,
+    };
+    for k in 0..=last {
+        animation
+            .camera_at(&still, k)
+            .check()
+            .map_err(|e| at.at(a.span(), format!("animation: frame {k}: camera: {e}")))?;
+    }
+    Ok(animation)
 }
