@@ -11,7 +11,7 @@ use clap::Args;
 
 use whitted::image_io::{self, Format};
 use whitted::render::{self, RenderControl};
-use whitted::settings::{Overrides, Precision, Preset, Region};
+use whitted::settings::{Encoding, Overrides, Precision, Preset, Region};
 
 use super::load_scene;
 
@@ -54,6 +54,10 @@ pub(crate) struct RenderArgs {
     /// other options override its settings.
     #[arg(long, value_name = "PRESET")]
     quality: Option<Preset>,
+    /// How values become 8-bit bytes: linear (the default) or srgb (the sRGB curve);
+    /// overrides the scene's. EXR files stay linear.
+    #[arg(long, value_name = "ENCODING")]
+    encoding: Option<Encoding>,
     /// No progress bar and no closing line.
     #[arg(short, long)]
     quiet: bool,
@@ -72,6 +76,7 @@ impl RenderArgs {
             precision: self.reference.then_some(Precision::Reference),
             region: self.region,
             threads: self.threads.map(|t| t as usize),
+            encoding: self.encoding,
         }
     }
 }
@@ -144,7 +149,7 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
                 path.display()
             ));
         }
-        image_io::save(&frame, path, *format)?;
+        image_io::save(&frame, path, *format, opts.encoding)?;
         if !args.quiet {
             eprintln!("wrote {}", path.display());
         }
