@@ -23,7 +23,7 @@ use indicatif::ProgressBar;
 pub use analysis::{fixed_spp_time_for, knee};
 pub use grid::{grid, study_scenes, BenchScene, Setting};
 pub use metrics::{compare, measure, Comparison, Errors, Levels};
-pub use report::{summary, CSV_HEADER};
+pub use report::{replot, summary, CSV_HEADER};
 
 use crate::settings::{Preset, Quality};
 use analysis::{mark_pareto, median};
