@@ -99,6 +99,7 @@ fn frames(c: &mut Criterion) {
 /// full pass that takes its pixels), and the conversions for the screen.
 fn viewer(c: &mut Criterion) {
     use std::sync::Arc;
+    use whitted::settings::Encoding;
     use whitted::viewer::buffer::{blit_xrgb, fill_for_screen, fill_upscaled_for_screen};
     use whitted::viewer::controls::{Action, CameraControl};
     use whitted::viewer::worker::{self, Buffers, Job, TracerCache};
@@ -140,24 +141,32 @@ fn viewer(c: &mut Criterion) {
         .expect("renders")
         .0;
     let (mut frame, mut rgba) = (Frame::new(w, h), Vec::new());
-    group.bench_function("screen_fill_1280x720", |b| {
-        b.iter(|| {
-            fill_for_screen(&mut frame, &mut rgba, |j, row| {
-                let from = &image.pixels[j * row.len()..(j + 1) * row.len()];
-                whitted::render::pixel_values(from, 1, row)
-            })
-        })
-    });
     let mut small = scene.settings();
     (small.width, small.height) = (w / 2, h / 2);
     let preview = render(&scene, &small, &RenderControl::default())
         .expect("renders")
         .0;
-    group.bench_function("preview_fill_1280x720_factor_2", |b| {
-        b.iter(|| {
-            fill_upscaled_for_screen(&mut frame, &mut rgba, (&preview.pixels, preview.width), 2)
-        })
-    });
+    for encoding in Encoding::ALL {
+        // The linear names are those of the benchmarks before the sRGB option.
+        let suffix = match encoding {
+            Encoding::Linear => String::new(),
+            other => format!("_{other}"),
+        };
+        group.bench_function(format!("screen_fill_1280x720{suffix}"), |b| {
+            b.iter(|| {
+                fill_for_screen(&mut frame, &mut rgba, encoding, |j, row| {
+                    let from = &image.pixels[j * row.len()..(j + 1) * row.len()];
+                    whitted::render::pixel_values(from, 1, row)
+                })
+            })
+        });
+        group.bench_function(format!("preview_fill_1280x720_factor_2{suffix}"), |b| {
+            b.iter(|| {
+                let values = (preview.pixels.as_slice(), preview.width);
+                fill_upscaled_for_screen(&mut frame, &mut rgba, values, 2, encoding)
+            })
+        });
+    }
     let mut surface = vec![0u32; (w * h) as usize];
     group.bench_function("blit_xrgb_1280x720", |b| {
         b.iter(|| blit_xrgb(&rgba, w, h, &mut surface, w, h))

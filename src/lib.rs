@@ -26,7 +26,7 @@
 //! assert!(stats.rays.total() > 0);
 //! # let dir = tempfile::tempdir()?;
 //! # let path = dir.path().join("hw3.png");
-//! image_io::save(&frame, &path, Format::Png)?; // row 0 of a file is the top
+//! image_io::save(&frame, &path, Format::Png, settings.encoding)?; // row 0 at the top
 //! # Ok(())
 //! # }
 //! ```

@@ -9,10 +9,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use cli::bench::BenchArgs;
+use cli::compare::CompareArgs;
 use cli::render::RenderArgs;
 use cli::stitch::StitchArgs;
 use whitted::scene;
-use whitted::settings::Preset;
+use whitted::settings::{Encoding, Overrides, Preset};
 
 #[derive(Parser)]
 #[command(
@@ -34,6 +35,9 @@ enum Command {
         /// Quality preset: draft, default, high or reference (docs/quality.md).
         #[arg(long, value_name = "PRESET")]
         quality: Option<Preset>,
+        /// Bytes on screen: linear or srgb (overrides the scene's).
+        #[arg(long, value_name = "ENCODING")]
+        encoding: Option<Encoding>,
     },
     /// Render without a window and write image files.
     Render(RenderArgs),
@@ -63,6 +67,10 @@ enum Command {
     /// Measure run time against error over a grid of quality settings on several
     /// scenes; writes bench.csv, bench.md and bench.svg (docs/quality.md).
     Bench(BenchArgs),
+    /// Compare two images of the same size: one line of RMSE, PSNR, largest
+    /// difference, share of pixels off by more than one level and mean FLIP; exit
+    /// status 1 past a threshold.
+    Compare(CompareArgs),
     /// Print a built-in scene as a scene file.
     Scene {
         /// The built-in scene: only "hw3".
@@ -88,11 +96,23 @@ fn main() -> ExitCode {
         }
     };
     let result = match cli.command {
-        None => cli::view(None, None),
-        Some(Command::View { scene, quality }) => cli::view(scene.as_deref(), quality),
+        None => cli::view(None, Overrides::default()),
+        Some(Command::View {
+            scene,
+            quality,
+            encoding,
+        }) => cli::view(
+            scene.as_deref(),
+            Overrides {
+                quality,
+                encoding,
+                ..Overrides::default()
+            },
+        ),
         Some(Command::Bench(args)) => cli::bench::bench_command(args),
         Some(Command::Render(args)) => cli::render::render_command(args),
         Some(Command::Stitch(args)) => cli::stitch::stitch_command(args),
+        Some(Command::Compare(args)) => cli::compare::compare_command(args),
         Some(Command::Time {
             scene,
             runs,

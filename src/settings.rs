@@ -211,6 +211,52 @@ impl FromStr for Preset {
     }
 }
 
+/// How linear values become 8-bit bytes (SPEC §4 `encoding`): in files other than EXR,
+/// and in the window.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Encoding {
+    /// `round(clamp(c, 0, 1)·255)`: the assignment's bytes.
+    #[default]
+    Linear,
+    /// The sRGB transfer curve, then the same rounding.
+    Srgb,
+}
+
+impl Encoding {
+    /// Both encodings.
+    pub const ALL: [Encoding; 2] = [Encoding::Linear, Encoding::Srgb];
+
+    /// The name in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Encoding::Linear => "linear",
+            Encoding::Srgb => "srgb",
+        }
+    }
+}
+
+impl fmt::Display for Encoding {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A name that is not one of the [`Encoding`]s.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown encoding \"{0}\": expected linear or srgb")]
+pub struct UnknownEncoding(pub String);
+
+impl FromStr for Encoding {
+    type Err = UnknownEncoding;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Encoding::ALL
+            .into_iter()
+            .find(|e| e.name() == s)
+            .ok_or_else(|| UnknownEncoding(s.to_string()))
+    }
+}
+
 /// A rectangle of the output image in image-tool coordinates: origin at the TOP-left.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Region {
@@ -292,6 +338,8 @@ pub struct Settings {
     pub tile: Option<Tile>,
     /// Worker threads (`None`: all cores).
     pub threads: Option<usize>,
+    /// How values become 8-bit bytes.
+    pub encoding: Encoding,
 }
 
 impl Default for Settings {
@@ -306,6 +354,7 @@ impl Default for Settings {
             region: None,
             tile: None,
             threads: None,
+            encoding: Encoding::Linear,
         }
     }
 }
@@ -335,6 +384,8 @@ pub struct Overrides {
     pub tile: Option<Tile>,
     /// Worker threads.
     pub threads: Option<usize>,
+    /// How values become 8-bit bytes.
+    pub encoding: Option<Encoding>,
 }
 
 impl Overrides {
@@ -364,6 +415,7 @@ impl Overrides {
             region: part(later, &base).0,
             tile: part(later, &base).1,
             threads: later.threads.or(base.threads),
+            encoding: later.encoding.or(base.encoding),
         }
     }
 }
@@ -395,6 +447,7 @@ impl Settings {
             (self.region, self.tile) = (o.region, o.tile);
         }
         self.threads = o.threads.or(self.threads);
+        self.encoding = o.encoding.unwrap_or(self.encoding);
         self
     }
 
@@ -557,9 +610,19 @@ mod tests {
             prop::option::of((0u32..9, 0u32..9, 1u32..9, 1u32..9)),
             prop::option::of((0u32..9, 1u32..9)),
             prop::option::of(1usize..9),
+            prop::option::of(prop::sample::select(Encoding::ALL.to_vec())),
         )
             .prop_map(
-                |(quality, (width, height, spp, max_depth), seed, precision, r, t, threads)| {
+                |(
+                    quality,
+                    (width, height, spp, max_depth),
+                    seed,
+                    precision,
+                    r,
+                    t,
+                    threads,
+                    encoding,
+                )| {
                     Overrides {
                         quality,
                         width,
@@ -576,6 +639,7 @@ mod tests {
                         }),
                         tile: t.map(|(index, count)| Tile { index, count }),
                         threads,
+                        encoding,
                     }
                 },
             )
@@ -740,6 +804,18 @@ mod tests {
             outside.check().unwrap_err().to_string(),
             "tile 4/4 does not exist in a 1280x720 image: expected an index from 0 to 3 and \
              at most as many tiles as pixels"
+        );
+    }
+
+    #[test]
+    fn encodings_parse_from_their_names_only() {
+        for e in Encoding::ALL {
+            assert_eq!(e.name().parse::<Encoding>(), Ok(e));
+        }
+        assert_eq!(Settings::default().encoding, Encoding::Linear);
+        assert_eq!(
+            "sRGB".parse::<Encoding>().unwrap_err().to_string(),
+            "unknown encoding \"sRGB\": expected linear or srgb"
         );
     }
 

@@ -3,7 +3,7 @@
 //! none by more than 8 except a handful on silhouettes (where an `f32` ray may pass on
 //! the other side of an edge than the `f64` one).
 
-use whitted::image_io::to_rgb8;
+use whitted::image_io::{to_rgb8, Encoding};
 use whitted::render::{self, RenderControl};
 use whitted::scene::{hw3_scene, HW3_DEFAULT_SEED};
 use whitted::settings::Precision;
@@ -21,7 +21,10 @@ fn fast_matches_reference_on_hw3_640x360() {
     let (fast, _) = render::render(&scene, &opts, &control).expect("fast render");
     opts.quality.precision = Precision::Reference;
     let (reference, _) = render::render(&scene, &opts, &control).expect("reference render");
-    let (fast, reference) = (to_rgb8(&fast), to_rgb8(&reference));
+    let (fast, reference) = (
+        to_rgb8(&fast, Encoding::Linear),
+        to_rgb8(&reference, Encoding::Linear),
+    );
     let (w, h) = reference.dimensions();
 
     let level = |x: u32, y: u32| -> u8 {

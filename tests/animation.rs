@@ -15,6 +15,7 @@ use whitted::camera::CameraSpec;
 use whitted::image_io;
 use whitted::render::{self, RenderControl, Sequence};
 use whitted::scene::{hw3_scene, to_toml, Animation, CameraKey, Motion, HW3_DEFAULT_SEED};
+use whitted::settings::Encoding;
 use whitted::{Overrides, Scene};
 
 const BIN: &str = env!("CARGO_BIN_EXE_whitted");
@@ -214,7 +215,7 @@ fn still_bytes(scene: &Scene) -> Vec<u8> {
         ..Overrides::default()
     });
     let (frame, _) = render::render(scene, &settings, &RenderControl::default()).unwrap();
-    image_io::to_rgb8(&frame).into_raw()
+    image_io::to_rgb8(&frame, Encoding::Linear).into_raw()
 }
 
 /// hw3 seen from above and in front of its balls, turning about (0, 0, -2).
@@ -335,7 +336,10 @@ fn a_sequence_renders_each_frame_as_its_still_scene_does() {
             .render(&camera, &settings, &RenderControl::default())
             .unwrap();
         let alone = still_bytes(&scene.frame(k, 96, 54));
-        assert!(image_io::to_rgb8(&frame).into_raw() == alone, "frame {k}");
+        assert!(
+            image_io::to_rgb8(&frame, Encoding::Linear).into_raw() == alone,
+            "frame {k}"
+        );
     }
 }
 
@@ -577,7 +581,7 @@ fn the_committed_turntable_gif_is_the_turntable_scene() {
     let mut still = scene.clone();
     still.animation = None;
     let (frame, _) = render::render(&still, &settings, &RenderControl::default()).unwrap();
-    let expected = image_io::to_rgb8(&frame);
+    let expected = image_io::to_rgb8(&frame, Encoding::Linear);
     let decoded = rgb(frames.into_iter().next().unwrap());
     let off = decoded
         .pixels()

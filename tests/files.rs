@@ -11,7 +11,7 @@ use std::path::Path;
 use std::process::Command;
 
 use image::{Rgb32FImage, RgbImage};
-use whitted::image_io::{self, Format};
+use whitted::image_io::{self, Encoding, Format};
 use whitted::render::{self, Frame, RenderControl};
 use whitted::scene::{hw3_scene, HW3_DEFAULT_SEED};
 
@@ -55,7 +55,7 @@ fn assert_upright(img: &RgbImage, tol: u8, what: &str) {
 #[test]
 fn every_format_decodes_to_the_rendered_image() {
     let frame = library_frame();
-    let expected = image_io::to_rgb8(&frame);
+    let expected = image_io::to_rgb8(&frame, Encoding::Linear);
     let expected_f32: Rgb32FImage = image_io::to_rgb32f(&frame);
     assert_upright(&expected, 0, "the library's bytes");
 
@@ -217,22 +217,28 @@ fn a_failed_save_leaves_nothing_behind() {
     // The target is an existing folder: refused, and nothing is created beside it.
     let target = dir.path().join("taken.png");
     std::fs::create_dir(&target).unwrap();
-    let err = image_io::save(&frame, &target, Format::Png).unwrap_err();
+    let err = image_io::save(&frame, &target, Format::Png, Encoding::Linear).unwrap_err();
     assert!(err.to_string().contains("taken.png"), "{err}");
     assert_eq!(entries(dir.path()), ["taken.png"]);
     assert!(entries(&target).is_empty());
 
     // A missing folder: an error naming the path, nothing created.
     let missing = dir.path().join("no/such/folder/a.png");
-    let err = image_io::save(&frame, &missing, Format::Png).unwrap_err();
+    let err = image_io::save(&frame, &missing, Format::Png, Encoding::Linear).unwrap_err();
     assert!(err.to_string().contains("no/such/folder"), "{err}");
     assert_eq!(entries(dir.path()), ["taken.png"]);
 
     // A successful save replaces an existing file whole.
     let file = dir.path().join("a.ppm");
     std::fs::write(&file, b"old contents").unwrap();
-    image_io::save(&frame, &file, Format::Ppm { binary: true }).unwrap();
-    assert!(image::open(&file).unwrap().into_rgb8() == image_io::to_rgb8(&frame));
+    image_io::save(
+        &frame,
+        &file,
+        Format::Ppm { binary: true },
+        Encoding::Linear,
+    )
+    .unwrap();
+    assert!(image::open(&file).unwrap().into_rgb8() == image_io::to_rgb8(&frame, Encoding::Linear));
     let mut names = entries(dir.path());
     names.sort();
     assert_eq!(names, ["a.ppm", "taken.png"]);
@@ -306,7 +312,7 @@ fn the_committed_readme_image_is_the_hw3_render() {
     let scene = hw3_scene(HW3_DEFAULT_SEED);
     let opts = scene.settings();
     let (frame, _) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
-    let fresh = image_io::to_rgb8(&frame);
+    let fresh = image_io::to_rgb8(&frame, Encoding::Linear);
     assert_eq!(committed.dimensions(), (1280, 720));
     let off: Vec<u8> = committed
         .pixels()
@@ -334,7 +340,7 @@ fn a_symbolic_link_keeps_pointing_at_the_new_image() {
     let link = dir.path().join("link.png");
     std::os::unix::fs::symlink(&real, &link).unwrap();
 
-    image_io::save(&frame, &link, Format::Png).unwrap();
+    image_io::save(&frame, &link, Format::Png, Encoding::Linear).unwrap();
     // The link is still a link to the same file, which now holds the image; the
     // temporary file went into the real file's folder and is gone.
     assert!(std::fs::symlink_metadata(&link)
@@ -342,7 +348,7 @@ fn a_symbolic_link_keeps_pointing_at_the_new_image() {
         .file_type()
         .is_symlink());
     assert_eq!(std::fs::read_link(&link).unwrap(), real);
-    assert!(image::open(&real).unwrap().into_rgb8() == image_io::to_rgb8(&frame));
+    assert!(image::open(&real).unwrap().into_rgb8() == image_io::to_rgb8(&frame, Encoding::Linear));
     assert_eq!(entries(&images), ["real.png"]);
 }
 
@@ -387,5 +393,5 @@ fn a_fifo_receives_the_image_in_place() {
     assert_eq!(entries(dir.path()), ["pipe.ppm"]);
     let bytes = reader.join().unwrap();
     let decoded = image::load_from_memory(&bytes).unwrap().into_rgb8();
-    assert!(decoded == image_io::to_rgb8(&library_frame()));
+    assert!(decoded == image_io::to_rgb8(&library_frame(), Encoding::Linear));
 }

@@ -249,7 +249,7 @@ color = [1.0, 0.5, 0.25]
     let r = 0.5f64.sqrt();
     let centre = DVec3::new(r, 0.4 * r, 0.125 * r);
     assert_pixel(&frames, 1, 1, centre);
-    let bytes = whitted::image_io::to_rgb8(&frames.0);
+    let bytes = whitted::image_io::to_rgb8(&frames.0, whitted::image_io::Encoding::Linear);
     assert_eq!(bytes.get_pixel(1, 1).0, [180, 72, 23]);
     // Bottom-left pixel (0, 0): s = t = 1/6, d ∝ (−2/3, −2/3, −1), 43° off the axis,
     // outside the sphere's 19.5° (asin 1/3): sky with d.y = −(2/3)/√(17/9) = −0.48507.

@@ -69,7 +69,12 @@ fn same_bytes(a: &str, b: &str) {
 fn tiles_stitch_into_the_bytes_of_the_whole_render() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    for (count, extra) in [(16, &[][..]), (7, &["--spp", "4"][..]), (1, &[][..])] {
+    for (count, extra) in [
+        (16, &[][..]),
+        (7, &["--spp", "4"][..]),
+        (1, &[][..]),
+        (4, &["--encoding", "srgb"][..]),
+    ] {
         let whole_png = path(d, "whole.png");
         let whole_exr = path(d, "whole.exr");
         let whole_ppm = path(d, "whole.ppm");
@@ -92,6 +97,10 @@ fn tiles_stitch_into_the_bytes_of_the_whole_render() {
         let out = path(d, "stitched.exr");
         assert!(stitch(&out, &exrs).status.success());
         same_bytes(&out, &whole_exr);
+        // Linear parts make the 8-bit files too, in the parts' encoding.
+        let png = path(d, "from-exr.png");
+        assert!(stitch(&png, &exrs).status.success());
+        same_bytes(&png, &whole_png);
         // The order of the parts does not matter.
         let mut reversed = exrs.clone();
         reversed.reverse();

@@ -664,6 +664,42 @@ fn the_automatic_blitter_uses_pixels_on_a_gpu_only() {
     }
 }
 
+/// With `encoding = "srgb"` the window shows the sRGB file's bytes, and `S` saves them.
+#[test]
+fn with_srgb_the_window_shows_the_bytes_of_the_srgb_file() {
+    if !x_tools_or_skip("sRGB viewer test") {
+        return;
+    }
+    let x = XServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let mut scene = whitted::scene::hw3_scene(whitted::scene::HW3_DEFAULT_SEED);
+    (scene.image.width, scene.image.height) = (Some(320), Some(180));
+    scene.image.encoding = Some(whitted::settings::Encoding::Srgb);
+    let path = dir.join("small.toml");
+    fs::write(&path, whitted::scene::to_toml(&scene)).unwrap();
+    let expected = headless(dir, &path, &[], "srgb.png");
+    let linear = headless(dir, &path, &["--encoding", "linear"], "linear.png");
+    assert!(
+        differing(&expected, &linear) > 1000,
+        "sRGB changes the bytes"
+    );
+
+    let (mut viewer, window) = start_viewer(&x, dir, &path, "softbuffer");
+    x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
+    let diff = screenshot_matching(&x, &window, dir, &expected);
+    assert_eq!(diff, 0, "{diff} pixels differ from the sRGB file");
+    x.key(&window, "s");
+    viewer.wait_stdout("saved small-001.png and small-001.ppm");
+    for name in ["small-001.png", "small-001.ppm"] {
+        let saved = image::open(dir.join(name)).unwrap().to_rgb8();
+        assert_eq!(differing(&saved, &expected), 0, "{name}");
+    }
+    x.key(&window, "q");
+    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
+    assert!(status.success());
+}
+
 #[test]
 fn without_a_display_it_says_so_and_exits_1() {
     let out = Command::new(BIN)

@@ -15,7 +15,7 @@ use pyo3::types::{PyDict, PyTuple};
 
 use whitted::image_io::{self, Format};
 use whitted::render::{Frame, RenderControl};
-use whitted::settings::{Overrides, Precision, Preset, Region, Settings, Tile};
+use whitted::settings::{Encoding, Overrides, Precision, Preset, Region, Settings, Tile};
 
 create_exception!(
     whitted,
@@ -54,6 +54,18 @@ impl PyScene {
     #[getter]
     fn spheres(&self) -> usize {
         self.inner.spheres.len()
+    }
+
+    /// Frames of the scene's animation (1 for a still scene).
+    #[getter]
+    fn frames(&self) -> u32 {
+        self.inner.frames()
+    }
+
+    /// Frames a second of the scene's animation (24 without an `[animation]` table).
+    #[getter]
+    fn fps(&self) -> f64 {
+        self.inner.animation.as_ref().map_or(24.0, |a| a.fps)
     }
 
     /// How many point lights the scene holds.
@@ -129,14 +141,17 @@ struct Options {
     depth: Option<u32>,
     seed: Option<u64>,
     quality: Option<String>,
+    encoding: Option<String>,
     region: Option<Rect>,
     tile: Option<(u32, u32)>,
+    frame: Option<u32>,
     threads: Option<usize>,
     reference: bool,
 }
 
 /// The keywords [`Options`] knows.
-const KEYWORDS: &str = "width, height, spp, depth, seed, quality, region, tile, threads, reference";
+const KEYWORDS: &str =
+    "width, height, spp, depth, seed, quality, encoding, region, tile, frame, threads, reference";
 
 impl Options {
     /// The options of a call's keyword arguments; `None` values count as not given,
@@ -158,6 +173,8 @@ impl Options {
                 "depth" => o.depth = Some(value.extract()?),
                 "seed" => o.seed = Some(value.extract()?),
                 "quality" => o.quality = Some(value.extract()?),
+                "encoding" => o.encoding = Some(value.extract()?),
+                "frame" => o.frame = Some(value.extract()?),
                 "region" => o.region = Some(value.extract()?),
                 "tile" => o.tile = Some(value.extract()?),
                 "threads" => o.threads = Some(value.extract()?),
@@ -172,6 +189,23 @@ impl Options {
         Ok(o)
     }
 
+    /// What to render: the scene (the frame asked for, as a still scene) and the
+    /// settings these options make of the scene's, checked.
+    fn resolve(&self, scene: &whitted::Scene) -> PyResult<(whitted::Scene, Settings)> {
+        let settings = self.settings(scene)?;
+        let Some(k) = self.frame else {
+            return Ok((scene.clone(), settings));
+        };
+        if k >= scene.frames() {
+            return Err(PyValueError::new_err(format!(
+                "frame {k} does not exist: the scene has {} frames (0 to {})",
+                scene.frames(),
+                scene.frames() - 1
+            )));
+        }
+        Ok((scene.frame(k, settings.width, settings.height), settings))
+    }
+
     /// The settings these options make of `scene`'s, checked.
     fn settings(&self, scene: &whitted::Scene) -> PyResult<Settings> {
         let quality = match &self.quality {
@@ -181,7 +215,15 @@ impl Options {
                     .map_err(|e| PyValueError::new_err(e.to_string()))?,
             ),
         };
+        let encoding = match &self.encoding {
+            None => None,
+            Some(name) => Some(
+                name.parse::<Encoding>()
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?,
+            ),
+        };
         let overrides = Overrides {
+            encoding,
             quality,
             width: self.width,
             height: self.height,
@@ -252,10 +294,10 @@ fn render<'py>(
     scene: &PyScene,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray3<u8>>> {
-    let settings = Options::from_kwargs(options)?.settings(&scene.inner)?;
-    let frame = render_frame(py, &scene.inner, &settings)?;
+    let (scene, settings) = Options::from_kwargs(options)?.resolve(&scene.inner)?;
+    let frame = render_frame(py, &scene, &settings)?;
     let (w, h) = (frame.width as usize, frame.height as usize);
-    let bytes = image_io::to_rgb8(&frame).into_raw();
+    let bytes = image_io::to_rgb8(&frame, settings.encoding).into_raw();
     PyArray1::from_vec(py, bytes).reshape([h, w, 3])
 }
 
@@ -269,8 +311,8 @@ fn render_linear<'py>(
     scene: &PyScene,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let settings = Options::from_kwargs(options)?.settings(&scene.inner)?;
-    let frame = render_frame(py, &scene.inner, &settings)?;
+    let (scene, settings) = Options::from_kwargs(options)?.resolve(&scene.inner)?;
+    let frame = render_frame(py, &scene, &settings)?;
     let (w, h) = (frame.width as usize, frame.height as usize);
     let values = image_io::to_rgb32f(&frame).into_raw();
     PyArray1::from_vec(py, values).reshape([h, w, 3])
@@ -282,7 +324,7 @@ fn render_linear<'py>(
 #[pyfunction]
 #[pyo3(signature = (scene, **options))]
 fn plan(scene: &PyScene, options: Option<&Bound<'_, PyDict>>) -> PyResult<((u32, u32), Rect)> {
-    let settings = Options::from_kwargs(options)?.settings(&scene.inner)?;
+    let (_, settings) = Options::from_kwargs(options)?.resolve(&scene.inner)?;
     let a = settings.area();
     Ok((
         (settings.width, settings.height),
@@ -292,15 +334,20 @@ fn plan(scene: &PyScene, options: Option<&Bound<'_, PyDict>>) -> PyResult<((u32,
 
 /// Writes an image file atomically, format by extension, as the command line does:
 /// a `uint8` array `(h, w, 3)` to `.png .ppm .bmp .jpg`; a `float32` array (linear
-/// values) to any of those or `.exr`. `ppm_binary` writes P6 instead of P3.
+/// values) to any of those or `.exr`, its bytes made in `encoding` ("linear" or
+/// "srgb"). `ppm_binary` writes P6 instead of P3.
 #[pyfunction]
-#[pyo3(signature = (path, image, *, ppm_binary=false))]
+#[pyo3(signature = (path, image, *, ppm_binary=false, encoding="linear"))]
 fn write_image(
     py: Python<'_>,
     path: PathBuf,
     image: &Bound<'_, PyAny>,
     ppm_binary: bool,
+    encoding: &str,
 ) -> PyResult<()> {
+    let encoding: Encoding = encoding
+        .parse()
+        .map_err(|e: whitted::settings::UnknownEncoding| PyValueError::new_err(e.to_string()))?;
     let format =
         Format::from_path(&path, ppm_binary).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let shape_error = || PyValueError::new_err("expected an array of shape (height, width, 3)");
@@ -343,7 +390,7 @@ fn write_image(
     let raw: Vec<f32> = values.as_array().iter().copied().collect();
     let top_down = image::Rgb32FImage::from_raw(w, h, raw).ok_or_else(shape_error)?;
     let frame = image_io::parts::frame_of(&top_down);
-    py.detach(|| image_io::save(&frame, &path, format))
+    py.detach(|| image_io::save(&frame, &path, format, encoding))
         .map_err(io)
 }
 

@@ -164,3 +164,29 @@ def test_a_bad_scene_file_is_one_line_and_exit_1(tmp_path):
     )
     assert run.returncode == 1
     assert run.stderr.strip() == f"whitted: error: {scene}:3:10: sphere 1: radius must be > 0, got -1"
+
+
+def test_a_turntable_on_the_cluster_equals_the_command_lines_frames(cluster, whitted_bin, tmp_path):
+    from test_render import turntable_text
+    from whitted.distributed import render_frames
+
+    _, _, client = cluster
+    path = tmp_path / "spin.toml"
+    path.write_text(turntable_text(12))
+    scene = whitted.load_scene(path)
+    ours = tmp_path / "ours"
+    ours.mkdir()
+    written = render_frames(client, scene, str(ours / "f-%02d.png"), width=320, height=180)
+    assert written == [str(ours / f"f-{k:02d}.png") for k in range(12)]
+    theirs = tmp_path / "theirs"
+    theirs.mkdir()
+    subprocess.run([whitted_bin, "render", str(path), "--quiet", "--width", "320", "--height", "180",
+                    "-o", str(theirs / "f-%02d.png")], check=True)
+    for k in range(12):
+        assert (ours / f"f-{k:02d}.png").read_bytes() == (theirs / f"f-{k:02d}.png").read_bytes(), k
+    # A slice, as --frame A..B.
+    again = render_frames(client, scene, str(ours / "g-%02d.png"), range(4, 6), width=320, height=180)
+    assert again == [str(ours / "g-04.png"), str(ours / "g-05.png")]
+    assert (ours / "g-05.png").read_bytes() == (theirs / "f-05.png").read_bytes()
+    with pytest.raises(ValueError, match="frame 12 does not exist"):
+        render_frames(client, scene, str(ours / "h-%02d.png"), 12)

@@ -169,3 +169,37 @@ def test_ctrl_c_stops_a_render_within_a_fraction_of_a_second():
     stopped = time.perf_counter() - start
     timer.join()
     assert stopped < 0.3 + 0.5, f"the render went on for {stopped - 0.3:.2f} s after Ctrl-C"
+
+
+def turntable_text(frames: int) -> str:
+    body = (REPO / "assets" / "scenes" / "hw3.toml").read_text()
+    camera = '[camera]\nlook_from = [0, 0.5, 1]\nlook_at = [0, -0.2, -2]\nup = [0, 1, 0]\nvfov = 50\n\n'
+    return camera + body + f"\n[animation]\nframes = {frames}\norbit = 360\n"
+
+
+def test_frames_render_as_the_command_line_renders_them(cli, tmp_path):
+    path = tmp_path / "spin.toml"
+    path.write_text(turntable_text(8))
+    scene = whitted.load_scene(path)
+    assert (scene.frames, scene.fps) == (8, 24.0)
+    for k in (0, 3, 7):
+        ours = whitted.render(scene, frame=k, width=160, height=90)
+        assert np.array_equal(ours, cli("--width", "160", "--height", "90", "--frame", str(k), scene=path)), k
+    assert not np.array_equal(whitted.render(scene, frame=3, width=160, height=90),
+                              whitted.render(scene, frame=0, width=160, height=90))
+    with pytest.raises(ValueError, match="frame 8 does not exist"):
+        whitted.render(scene, frame=8)
+    # A still scene has one frame: frame 0 is the image.
+    assert np.array_equal(whitted.render(whitted.hw3_scene(), frame=0, width=64, height=36),
+                          whitted.render(whitted.hw3_scene(), width=64, height=36))
+
+
+def test_srgb_bytes_are_the_command_line_srgb_bytes(cli):
+    ours = whitted.render(whitted.hw3_scene(), width=160, height=90, encoding="srgb")
+    assert np.array_equal(ours, cli("--width", "160", "--height", "90", "--encoding", "srgb"))
+    linear = whitted.render_linear(whitted.hw3_scene(), width=160, height=90)
+    c = np.clip(linear.astype(np.float64), 0.0, 1.0)
+    curve = np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1 / 2.4) - 0.055)
+    assert np.array_equal(ours, np.rint(curve * 255.0).astype(np.uint8))
+    with pytest.raises(ValueError, match='unknown encoding "gamma"'):
+        whitted.render(whitted.hw3_scene(), encoding="gamma")

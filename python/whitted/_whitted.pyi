@@ -28,6 +28,12 @@ class Scene:
     def spheres(self) -> int:
         """How many spheres the scene holds."""
     @property
+    def frames(self) -> int:
+        """Frames of the scene's animation (1 for a still scene)."""
+    @property
+    def fps(self) -> float:
+        """Frames a second of the scene's animation."""
+    @property
     def lights(self) -> int:
         """How many point lights the scene holds."""
     def to_toml(self) -> str:
@@ -51,15 +57,19 @@ def render(
     depth: Optional[int] = None,
     seed: Optional[int] = None,
     quality: Optional[str] = None,
+    encoding: Optional[str] = None,
     region: Optional[Rect] = None,
     tile: Optional[Tuple[int, int]] = None,
+    frame: Optional[int] = None,
     threads: Optional[int] = None,
     reference: bool = False,
 ) -> npt.NDArray[np.uint8]:
     """Renders to 8-bit RGB, shape (height, width, 3), top row first: the bytes
     ``whitted render -o x.png`` writes with the same options. With ``region`` or
-    ``tile``, only that rectangle. Bad options raise ``ValueError``; the GIL is
-    released while rendering and Ctrl-C raises ``KeyboardInterrupt``."""
+    ``tile``, only that rectangle; with ``frame``, that frame of the scene's
+    animation; ``encoding`` "srgb" applies the sRGB curve to the bytes. Bad options
+    raise ``ValueError``; the GIL is released while rendering and Ctrl-C raises
+    ``KeyboardInterrupt``."""
 
 def render_linear(
     scene: Scene,
@@ -70,8 +80,10 @@ def render_linear(
     depth: Optional[int] = None,
     seed: Optional[int] = None,
     quality: Optional[str] = None,
+    encoding: Optional[str] = None,
     region: Optional[Rect] = None,
     tile: Optional[Tuple[int, int]] = None,
+    frame: Optional[int] = None,
     threads: Optional[int] = None,
     reference: bool = False,
 ) -> npt.NDArray[np.float32]:
@@ -87,17 +99,22 @@ def plan(
     depth: Optional[int] = None,
     seed: Optional[int] = None,
     quality: Optional[str] = None,
+    encoding: Optional[str] = None,
     region: Optional[Rect] = None,
     tile: Optional[Tuple[int, int]] = None,
+    frame: Optional[int] = None,
     threads: Optional[int] = None,
     reference: bool = False,
 ) -> Tuple[Tuple[int, int], Rect]:
     """``((width, height), (x, y, w, h))``: the whole image's size and the rectangle
     ``render`` with these options gives. Checks the options without rendering."""
 
-def write_image(path: PathLike, image: npt.NDArray, *, ppm_binary: bool = False) -> None:
+def write_image(
+    path: PathLike, image: npt.NDArray, *, ppm_binary: bool = False, encoding: str = "linear"
+) -> None:
     """Writes a uint8 (8-bit formats) or float32 (linear; any format, .exr too) array
-    of shape (height, width, 3) atomically, format by extension, as the command line."""
+    of shape (height, width, 3) atomically, format by extension, as the command line;
+    a float32 array's bytes are made in ``encoding``."""
 
 def tile_region(index: int, count: int, width: int, height: int) -> Rect:
     """The rectangle of tile ``index`` of ``count`` over a width×height image."""

@@ -9,8 +9,9 @@ Nothing here schedules work itself::
     client = Client("tcp://scheduler:8786")
     img = render_tiles(client, scene, tiles=64, width=7680, height=4320, quality="high")
 
-From a shell: ``python -m whitted.distributed --scheduler ADDR SCENE -o FILE
-[--tiles N] [render options]``.
+Frames: ``render_frames(client, scene, "frames/f-%04d.png")``. From a shell:
+``python -m whitted.distributed --scheduler ADDR SCENE -o FILE [--tiles N]
+[--frames [K|A..B]] [render options]``.
 """
 
 from __future__ import annotations
@@ -102,8 +103,71 @@ def render_tiles(
     return image
 
 
-def _atomic_write(path: str, image: np.ndarray) -> None:
-    whitted.write_image(path, image)
+def _render_frame(scene: whitted.Scene, k: int, options: dict) -> tuple:
+    """One task: frame ``k``, with the worker's threads."""
+    opts = dict(options)
+    if opts.get("threads") is None:
+        opts["threads"] = _worker_threads()
+    return k, whitted.render(scene, frame=k, **opts)
+
+
+def frame_numbers(scene: whitted.Scene, frames: Any = None) -> list:
+    """The frames asked for: all of the scene's (``None``), one (an int), or any
+    iterable of frame numbers (a ``range``, say); each must exist."""
+    if frames is None:
+        numbers = list(range(scene.frames))
+    elif isinstance(frames, int):
+        numbers = [frames]
+    else:
+        numbers = list(frames)
+    bad = [k for k in numbers if not 0 <= k < scene.frames]
+    if bad:
+        raise ValueError(f"frame {bad[0]} does not exist: the scene has {scene.frames} frames")
+    return numbers
+
+
+def render_frames(
+    client: Any,
+    scene: whitted.Scene,
+    pattern: str,
+    frames: Any = None,
+    *,
+    on_frame: Optional[Callable[[int, int], None]] = None,
+    **options: Any,
+) -> list:
+    """Renders frames of ``scene``'s animation on the cluster of ``client``, one task a
+    frame, and writes each to ``pattern % k`` (e.g. ``"frames/f-%04d.png"``: the frame
+    number in the whole sequence) as it arrives, atomically, the bytes of
+    ``whitted render -o PATTERN --frame K``. ``frames``: all (``None``), one, or an
+    iterable of frame numbers. Returns the paths in frame order. ``on_frame(done,
+    total)`` is called as frames are written."""
+    from distributed import as_completed
+
+    numbers = frame_numbers(scene, frames)
+    if "frame" in options:
+        raise ValueError("render_frames takes the frames as `frames`")
+    whitted.plan(scene, **options)  # ValueError before anything is sent
+    paths = {k: pattern % k for k in numbers}
+    scene_future = client.scatter(scene, broadcast=False)
+    futures = [client.submit(_render_frame, scene_future, k, options, pure=False) for k in numbers]
+    try:
+        for done, (_, (k, image)) in enumerate(as_completed(futures, with_results=True), 1):
+            whitted.write_image(paths[k], image)
+            if on_frame is not None:
+                on_frame(done, len(numbers))
+    except BaseException:
+        client.cancel(futures)
+        raise
+    return [paths[k] for k in numbers]
+
+
+def _parse_frames(text: str) -> range:
+    """``K`` or ``A..B`` (end excluded), as the command line's ``--frame``."""
+    start, sep, end = text.partition("..")
+    try:
+        return range(int(start), int(end)) if sep else range(int(start), int(start) + 1)
+    except ValueError:
+        raise argparse.ArgumentTypeError("expected a frame K or a range A..B") from None
 
 
 def main(argv: Optional[Iterable[str]] = None) -> int:
@@ -116,12 +180,21 @@ def main(argv: Optional[Iterable[str]] = None) -> int:
     parser.add_argument("scene", help="a scene file (TOML), or 'hw3' for the built-in scene")
     parser.add_argument("-o", "--output", required=True, help="the image file (.png .ppm .bmp .jpg .exr)")
     parser.add_argument("--tiles", type=int, help="tiles (default: 4 per worker thread)")
+    parser.add_argument(
+        "--frames",
+        nargs="?",
+        const="all",
+        metavar="K|A..B",
+        help="render the animation's frames (all, or K, or A..B), one task a frame: "
+        "-o is then a pattern such as f-%%04d.png",
+    )
     parser.add_argument("--width", type=int)
     parser.add_argument("--height", type=int)
     parser.add_argument("--spp", type=int)
     parser.add_argument("--depth", type=int)
     parser.add_argument("--seed", type=int)
     parser.add_argument("--quality", choices=["draft", "default", "high", "reference"])
+    parser.add_argument("--encoding", choices=["linear", "srgb"])
     parser.add_argument("--reference", action="store_true", help="the f64 reference tracer")
     parser.add_argument("--timeout", type=float, default=10.0, help="seconds to reach the scheduler")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -136,13 +209,18 @@ def main(argv: Optional[Iterable[str]] = None) -> int:
         options = {
             k: v
             for k, v in vars(args).items()
-            if k in ("width", "height", "spp", "depth", "seed", "quality") and v is not None
+            if k in ("width", "height", "spp", "depth", "seed", "quality", "encoding") and v is not None
         }
         if args.reference:
             options["reference"] = True
         whitted.plan(scene, **options)
         linear = os.path.splitext(args.output)[1].lower() == ".exr"
-    except ValueError as e:  # SceneError is a ValueError
+        frames = None
+        if args.frames is not None:
+            frames = frame_numbers(scene, None if args.frames == "all" else _parse_frames(args.frames))
+            if "%" not in args.output:
+                return fail(f"{args.output}: frames need a numbered pattern such as f-%04d.png")
+    except (ValueError, argparse.ArgumentTypeError) as e:  # SceneError is a ValueError
         return fail(str(e))
 
     from distributed import Client
@@ -156,15 +234,19 @@ def main(argv: Optional[Iterable[str]] = None) -> int:
         if not args.quiet and sys.stderr.isatty():
             from tqdm import tqdm
 
-            bar = tqdm(total=args.tiles, unit="tile", file=sys.stderr)
+            unit = "frame" if frames is not None else "tile"
+            bar = tqdm(total=len(frames) if frames is not None else args.tiles, unit=unit, file=sys.stderr)
 
         def progress(done: int, total: int) -> None:
             if bar is not None:
                 bar.total = total
                 bar.update(1)
 
-        image = render_tiles(client, scene, args.tiles, linear=linear, on_tile=progress, **options)
-        _atomic_write(args.output, image)
+        if frames is not None:
+            render_frames(client, scene, args.output, frames, on_frame=progress, **options)
+        else:
+            image = render_tiles(client, scene, args.tiles, linear=linear, on_tile=progress, **options)
+            whitted.write_image(args.output, image)
     except KeyboardInterrupt:
         return fail("interrupted: no file was written")
     except (ValueError, OSError) as e:

@@ -5,7 +5,7 @@
 //! error with the Pareto front of each scene marked).
 //!
 //! `grid` holds the scenes and settings, `measure` renders them, `metrics` compares an
-//! image with the reference, `analysis` reads the rows (medians, Pareto front, knee),
+//! image with the reference (and serves `whitted compare`), `analysis` reads the rows (medians, Pareto front, knee),
 //! `report` and `plot` write the outputs; [`run`] drives them.
 
 mod analysis;
@@ -22,8 +22,8 @@ use indicatif::ProgressBar;
 
 pub use analysis::{fixed_spp_time_for, knee};
 pub use grid::{grid, study_scenes, BenchScene, Setting};
-pub use metrics::{compare, Errors};
-pub use report::{summary, CSV_HEADER};
+pub use metrics::{compare, measure, Comparison, Errors, Levels};
+pub use report::{replot, summary, CSV_HEADER};
 
 use crate::settings::{Preset, Quality};
 use analysis::{mark_pareto, median};

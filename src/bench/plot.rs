@@ -7,6 +7,36 @@ use super::analysis::scene_names;
 use super::Row;
 use crate::settings::Precision;
 
+/// The labelled and the unlabelled grid lines of a log axis over `(lo, hi)`: 1, 2 and 5
+/// times the powers of ten in the range (only the powers when that would make more
+/// than 8 labels, every multiple when fewer than 3), and every multiple 1–9 as light
+/// lines. Explicit, because plotters' own choice crowds the labels of a range of two
+/// decades and draws light lines so dense that they merge into grey bands.
+fn ticks((lo, hi): (f64, f64)) -> (Vec<f64>, Vec<f64>) {
+    let decades = lo.log10().floor() as i32..=hi.log10().ceil() as i32;
+    let within = |multiples: &[f64]| -> Vec<f64> {
+        decades
+            .clone()
+            .flat_map(|d| multiples.iter().map(move |m| m * 10f64.powi(d)))
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let every: Vec<f64> = (1..=9).map(f64::from).collect();
+    let mut bold = within(&[1.0, 2.0, 5.0]);
+    if bold.len() > 8 {
+        bold = within(&[1.0]);
+    } else if bold.len() < 3 {
+        bold = within(&every);
+    }
+    (bold, within(&every))
+}
+
+/// A tick value without trailing zeros: 0.5, 2, 10, 200.
+fn tick_label(v: f64) -> String {
+    let decimals = (-v.log10().floor()).max(0.0) as usize;
+    format!("{v:.decimals$}")
+}
+
 /// Time against RMSE, log-log, one panel per scene; the Pareto front joined by a line.
 pub(crate) fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
     use plotters::prelude::*;
@@ -20,8 +50,8 @@ pub(crate) fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
     let (top, bottom) = root.split_vertically(480 * panels_y as u32);
     let panels = top.split_evenly((panels_y, cols));
     // Explicit light greys: some SVG renderers ignore opacity.
-    let grid_bold = RGBColor(200, 200, 200);
-    let grid_light = RGBColor(235, 235, 235);
+    let grid_bold = RGBColor(205, 205, 205);
+    let grid_light = RGBColor(238, 238, 238);
     for (name, panel) in names.iter().zip(panels.iter()) {
         // The reference itself (error 0) has no place on a log axis; the tables give
         // its time.
@@ -40,23 +70,35 @@ pub(crate) fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
             y0 = y0.min(y);
             y1 = y1.max(y);
         }
+        let (xs, ys) = ((x0 * 0.8, x1 * 1.25), (y0 * 0.8, y1 * 1.25));
+        let ((x_bold, x_light), (y_bold, y_light)) = (ticks(xs), ticks(ys));
         let mut chart = ChartBuilder::on(panel)
             .caption(
                 format!("{name}: time against error, Pareto front in red"),
-                ("sans-serif", 18),
+                ("sans-serif", 20),
             )
             .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
             .build_cartesian_2d(
-                (x0 * 0.8..x1 * 1.25).log_scale(),
-                (y0 * 0.8..y1 * 1.25).log_scale(),
+                (xs.0..xs.1)
+                    .log_scale()
+                    .with_key_points(x_bold)
+                    .with_light_points(x_light),
+                (ys.0..ys.1)
+                    .log_scale()
+                    .with_key_points(y_bold)
+                    .with_light_points(y_light),
             )
             .map_err(|x| e(&x))?;
         chart
             .configure_mesh()
             .bold_line_style(grid_bold)
             .light_line_style(grid_light)
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v))
+            .label_style(("sans-serif", 15))
+            .axis_desc_style(("sans-serif", 15))
             .x_desc("median render time (ms, log)")
             .y_desc("RMSE vs reference (8-bit levels, log)")
             .draw()
@@ -109,12 +151,11 @@ pub(crate) fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
             .map_err(|x| e(&x))?;
         for (r, &p) in these.iter().zip(&pts) {
             if let Some(preset) = r.setting.preset {
+                // Beside the point, clear of its rings, rather than on it.
+                let label = EmptyElement::at(p)
+                    + Text::new(preset.name().to_string(), (9, 2), ("sans-serif", 15));
                 chart
-                    .draw_series(std::iter::once(Text::new(
-                        preset.name().to_string(),
-                        p,
-                        ("sans-serif", 13),
-                    )))
+                    .draw_series(std::iter::once(label))
                     .map_err(|x| e(&x))?;
             }
         }
@@ -151,4 +192,25 @@ pub(crate) fn plot(rows: &[Row], path: &Path) -> anyhow::Result<()> {
         .map_err(|x| e(&x))?;
     root.present().map_err(|x| e(&x))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_axes_get_few_readable_labels() {
+        // many_1000's time axis: 3.5 to 380 ms.
+        let (bold, light) = ticks((3.5, 380.0));
+        assert_eq!(bold, [5.0, 10.0, 20.0, 50.0, 100.0, 200.0]);
+        assert_eq!(light.len(), 6 + 9 + 3);
+        let labels: Vec<String> = bold.iter().map(|&v| tick_label(v)).collect();
+        assert_eq!(labels, ["5", "10", "20", "50", "100", "200"]);
+        // Six decades: the powers of ten only.
+        assert_eq!(ticks((0.5, 2e5)).0, [1.0, 10.0, 100.0, 1e3, 1e4, 1e5]);
+        // Less than a decade: every multiple.
+        assert_eq!(ticks((0.45, 0.95)).0.len(), 5);
+        assert_eq!(tick_label(0.5), "0.5");
+        assert_eq!(tick_label(0.02), "0.02");
+    }
 }

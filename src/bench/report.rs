@@ -9,8 +9,8 @@ use anyhow::Context;
 
 use super::analysis::{fixed_spp_time_for, knee, plain_row, scene_names};
 use super::plot::plot;
-use super::{BenchOptions, Row};
-use crate::settings::Precision;
+use super::{BenchOptions, Errors, Row, Setting};
+use crate::settings::{Adaptive, Precision, Quality};
 
 /// The CSV header; [`Row::csv`] fills every column.
 pub const CSV_HEADER: &str = "scene,setting,preset,precision,spp,adaptive_threshold,cutoff,\
@@ -48,6 +48,75 @@ impl Row {
             self.pareto
         )
     }
+}
+
+impl Row {
+    /// A line of `bench.csv` read back (the values as rounded there); `None` if it is
+    /// not one.
+    pub fn from_csv(line: &str) -> Option<Row> {
+        let f: Vec<&str> = line.trim_end().split(',').collect();
+        let [scene, _label, preset, precision, spp, adaptive, cutoff, max_depth, runs, median_s, min_s, rays, refined, rmse, psnr, off, max, flip, cutoff_bound, cutoff_error, pareto] =
+            f.as_slice()
+        else {
+            return None;
+        };
+        let quality = Quality {
+            spp: spp.parse().ok()?,
+            adaptive: match *adaptive {
+                "off" => None,
+                t => Some(Adaptive::with_threshold(t.parse().ok()?)),
+            },
+            cutoff: cutoff.parse().ok()?,
+            max_depth: max_depth.parse().ok()?,
+            precision: match *precision {
+                "f32" => Precision::Fast,
+                "f64" => Precision::Reference,
+                _ => return None,
+            },
+        };
+        Some(Row {
+            scene: scene.to_string(),
+            setting: Setting {
+                quality,
+                preset: match *preset {
+                    "none" => None,
+                    name => Some(name.parse().ok()?),
+                },
+            },
+            runs: runs.parse().ok()?,
+            median_s: median_s.parse().ok()?,
+            min_s: min_s.parse().ok()?,
+            rays: rays.parse().ok()?,
+            refined: refined.parse().ok()?,
+            errors: Errors {
+                rmse: rmse.parse().ok()?,
+                psnr: psnr.parse().ok()?,
+                off_by_more_than_1: off.parse().ok()?,
+                max: max.parse().ok()?,
+                flip: flip.parse().ok()?,
+            },
+            cutoff_bound: cutoff_bound.parse().ok()?,
+            cutoff_error: cutoff_error.parse().ok()?,
+            pareto: pareto.parse().ok()?,
+        })
+    }
+}
+
+/// Draws `bench.svg` in `out` again from the `bench.csv` there, without measuring.
+pub fn replot(out: &Path) -> anyhow::Result<()> {
+    let path = out.join("bench.csv");
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    let rows = text
+        .lines()
+        .enumerate()
+        .skip(1)
+        .map(|(n, line)| {
+            Row::from_csv(line)
+                .with_context(|| format!("{}:{}: not a row of the study", path.display(), n + 1))
+        })
+        .collect::<anyhow::Result<Vec<Row>>>()?;
+    plot(&rows, &out.join("bench.svg"))
 }
 
 fn precision_name(r: Precision) -> &'static str {
@@ -200,4 +269,21 @@ pub(crate) fn write_all(rows: &[Row], opts: &BenchOptions) -> anyhow::Result<()>
 
 fn write(path: &Path, text: &str) -> anyhow::Result<()> {
     std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_published_csv_reads_back_line_for_line() {
+        let text = include_str!("../../assets/bench/bench.csv");
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some(CSV_HEADER));
+        for line in lines {
+            let row = Row::from_csv(line).unwrap_or_else(|| panic!("{line}"));
+            assert_eq!(row.csv(), line);
+        }
+        assert_eq!(Row::from_csv("hw3,fast-spp1-d5,draft"), None);
+    }
 }

@@ -25,7 +25,7 @@ use whitted::image_io::{self, AnimatedFormat, AnimatedWriter, Format};
 use whitted::limits::MAX_FRAMES;
 use whitted::render::{Frame, RenderControl, RenderError, Sequence};
 use whitted::scene::{Animation, Scene};
-use whitted::settings::Settings;
+use whitted::settings::{Encoding, Settings};
 
 /// The animation options of `whitted render`.
 #[derive(Args, Clone, Debug, Default)]
@@ -291,7 +291,7 @@ pub(crate) fn render_frames(
         rays += stats.rays.total();
         let finished = Finished {
             k,
-            rgb: image_io::to_rgb8(&frame),
+            rgb: image_io::to_rgb8(&frame, settings.encoding),
             linear: linear.then_some(frame),
         };
         if frames_out.send(finished).is_err() {
@@ -373,7 +373,9 @@ fn write_frames(
                 Output::Animated(..) => continue,
             };
             match (&linear, format) {
-                (Some(frame), Format::Exr) => image_io::save(frame, &path, format)?,
+                (Some(frame), Format::Exr) => {
+                    image_io::save(frame, &path, format, Encoding::Linear)?
+                }
                 _ => {
                     let mut bytes = Vec::new();
                     image_io::encode_rgb8(&rgb, format, &mut bytes)

@@ -28,9 +28,15 @@ pub(crate) struct BenchArgs {
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
+    /// Measure nothing: draw bench.svg in the output folder again from its bench.csv.
+    #[arg(long)]
+    replot: bool,
 }
 
 pub(crate) fn bench_command(args: BenchArgs) -> anyhow::Result<()> {
+    if args.replot {
+        return bench::replot(&args.out);
+    }
     let opts = BenchOptions {
         out: args.out,
         width: args.size.0,

@@ -2,6 +2,7 @@
 
 pub(crate) mod animate;
 pub(crate) mod bench;
+pub(crate) mod compare;
 pub(crate) mod render;
 pub(crate) mod stitch;
 
@@ -10,7 +11,7 @@ use std::path::Path;
 use anyhow::Context;
 
 use whitted::scene::{self, Scene};
-use whitted::settings::{Overrides, Preset};
+use whitted::settings::Overrides;
 
 /// The built-in scene, embedded from the file the generator wrote
 /// (`whitted scene hw3 > assets/scenes/hw3.toml`); a test keeps the two in step.
@@ -30,15 +31,11 @@ pub(crate) fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
     }
 }
 
-pub(crate) fn view(path: Option<&Path>, quality: Option<Preset>) -> anyhow::Result<()> {
+/// The viewer on the scene at `path`, with `options` (the command line's) over the
+/// scene file's settings, as if the file gave them.
+pub(crate) fn view(path: Option<&Path>, options: Overrides) -> anyhow::Result<()> {
     let mut scene = load_scene(path)?;
-    if let Some(preset) = quality {
-        // As if the scene file named it: the viewer's Settings::for_scene applies it.
-        scene.image = scene.image.then(&Overrides {
-            quality: Some(preset),
-            ..Overrides::default()
-        });
-    }
+    scene.image = scene.image.then(&options);
     whitted::viewer::run(scene)
 }
 

@@ -12,7 +12,7 @@ use clap::Args;
 use whitted::image_io::parts::{self, Placement};
 use whitted::image_io::{self, Format};
 use whitted::render::{self, RenderControl};
-use whitted::settings::{Overrides, Precision, Preset, Region, Tile};
+use whitted::settings::{Encoding, Overrides, Precision, Preset, Region, Tile};
 
 use super::animate::{self, FrameOptions};
 use super::load_scene;
@@ -62,6 +62,10 @@ pub(crate) struct RenderArgs {
     /// other options override its settings.
     #[arg(long, value_name = "PRESET")]
     quality: Option<Preset>,
+    /// How values become 8-bit bytes: linear (the default) or srgb (the sRGB curve);
+    /// overrides the scene's. EXR files stay linear.
+    #[arg(long, value_name = "ENCODING")]
+    encoding: Option<Encoding>,
     /// No progress bar and no closing line.
     #[arg(short, long)]
     quiet: bool,
@@ -83,6 +87,7 @@ impl RenderArgs {
             region: self.region,
             tile: self.tile,
             threads: self.threads.map(|t| t as usize),
+            encoding: self.encoding,
         }
     }
 }
@@ -171,9 +176,10 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
         }
         let is_part = opts.region.is_some() || opts.tile.is_some();
         if is_part && matches!(format, Format::Png | Format::Exr) {
-            parts::save_part(&frame, &Placement::of(&scene, &opts), path, *format)?;
+            let placement = Placement::of(&scene, &opts);
+            parts::save_part(&frame, &placement, path, *format, opts.encoding)?;
         } else {
-            image_io::save(&frame, path, *format)?;
+            image_io::save(&frame, path, *format, opts.encoding)?;
         }
         if !args.quiet {
             eprintln!("wrote {}", path.display());

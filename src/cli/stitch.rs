@@ -40,7 +40,8 @@ pub(crate) fn stitch_command(args: StitchArgs) -> anyhow::Result<()> {
         .collect::<Result<_, parts::StitchError>>()?;
     match parts::stitch(&read)? {
         PartPixels::Linear(image) => {
-            image_io::save(&parts::frame_of(&image), &args.output, format)?;
+            let encoding = read[0].1.placement.encoding;
+            image_io::save(&parts::frame_of(&image), &args.output, format, encoding)?;
         }
         PartPixels::Bytes(image) => {
             if format == Format::Exr {

@@ -1,6 +1,8 @@
 //! The frame buffer to bytes and files, through the `image` crate. This is where the
-//! bottom-up frame is flipped to the top-down order of files, once. Every file is
-//! written whole or not at all: into a temporary file beside the target, then renamed.
+//! bottom-up frame is flipped to the top-down order of files, once, and where linear
+//! values become 8-bit bytes in the settings' [`Encoding`] (EXR stays linear). Every
+//! file is written whole or not at all: into a temporary file beside the target, then
+//! renamed.
 
 mod animated;
 
@@ -14,6 +16,10 @@ use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
 use image::{ExtendedColorType, ImageEncoder, Rgb32FImage, RgbImage};
 
 use crate::render::Frame;
+pub use crate::settings::Encoding;
+
+mod srgb;
+pub use srgb::{to_byte_srgb, to_byte_srgb_exact, SrgbTable};
 
 pub mod parts;
 pub use animated::{apng_delay, gif_delay_centiseconds, AnimatedFormat, AnimatedWriter};
@@ -94,16 +100,57 @@ pub fn to_byte(c: f32) -> u8 {
 /// 2²³: the smallest f32 whose spacing is 1.
 const ROUNDER: f32 = 8_388_608.0;
 
-/// The frame as 8-bit RGB, row 0 at the TOP (the order of files and screens).
-pub fn to_rgb8(frame: &Frame) -> RgbImage {
-    let (w, h) = (frame.width, frame.height);
-    let mut bytes = Vec::with_capacity(w as usize * h as usize * 3);
-    for row in frame.pixels.chunks_exact(w as usize).rev() {
-        for p in row {
-            bytes.extend_from_slice(&[to_byte(p.x), to_byte(p.y), to_byte(p.z)]);
+/// Linear values to bytes in one [`Encoding`]: [`to_byte`] or [`to_byte_srgb`], with
+/// the sRGB table looked up once rather than at every value.
+#[derive(Clone, Copy, Debug)]
+pub enum ByteEncoder {
+    /// [`to_byte`].
+    Linear,
+    /// [`SrgbTable::byte`].
+    Srgb(&'static SrgbTable),
+}
+
+impl ByteEncoder {
+    /// The encoder of `encoding` (the first sRGB one builds the table: well under a
+    /// millisecond).
+    pub fn new(encoding: Encoding) -> Self {
+        match encoding {
+            Encoding::Linear => ByteEncoder::Linear,
+            Encoding::Srgb => ByteEncoder::Srgb(SrgbTable::get()),
         }
     }
+
+    /// The byte of linear value `c`.
+    #[inline(always)]
+    pub fn byte(self, c: f32) -> u8 {
+        match self {
+            ByteEncoder::Linear => to_byte(c),
+            ByteEncoder::Srgb(table) => table.byte(c),
+        }
+    }
+}
+
+/// The frame as 8-bit RGB in `encoding`, row 0 at the TOP (the order of files and
+/// screens).
+pub fn to_rgb8(frame: &Frame, encoding: Encoding) -> RgbImage {
+    let (w, h) = (frame.width, frame.height);
+    // One loop per encoding, each with its conversion inlined.
+    let bytes = match ByteEncoder::new(encoding) {
+        ByteEncoder::Linear => rgb8_bytes(frame, to_byte),
+        ByteEncoder::Srgb(table) => rgb8_bytes(frame, |c| table.byte(c)),
+    };
     RgbImage::from_raw(w, h, bytes).expect("the buffer has w*h*3 bytes")
+}
+
+fn rgb8_bytes(frame: &Frame, byte: impl Fn(f32) -> u8) -> Vec<u8> {
+    let w = frame.width.max(1) as usize;
+    let mut bytes = Vec::with_capacity(frame.pixels.len() * 3);
+    for row in frame.pixels.chunks_exact(w).rev() {
+        for p in row {
+            bytes.extend_from_slice(&[byte(p.x), byte(p.y), byte(p.z)]);
+        }
+    }
+    bytes
 }
 
 /// The frame as linear 32-bit float RGB, row 0 at the top.
@@ -260,19 +307,24 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
     }
 }
 
-/// The frame encoded in `format`.
-pub fn encode(frame: &Frame, format: Format) -> Result<Vec<u8>, EncodeError> {
+/// The frame encoded in `format`, its bytes in `encoding` (EXR: linear values).
+pub fn encode(frame: &Frame, format: Format, encoding: Encoding) -> Result<Vec<u8>, EncodeError> {
     let mut out = Vec::new();
     match format {
         Format::Exr => out = exr_bytes(&to_rgb32f(frame), None)?,
-        _ => encode_rgb8(&to_rgb8(frame), format, &mut out)?,
+        _ => encode_rgb8(&to_rgb8(frame, encoding), format, &mut out)?,
     }
     Ok(out)
 }
 
-/// Saves the frame to `path` in `format`, atomically.
-pub fn save(frame: &Frame, path: &Path, format: Format) -> Result<(), SaveError> {
-    let bytes = encode(frame, format).map_err(|e| SaveError {
+/// Saves the frame to `path` in `format`, its bytes in `encoding`, atomically.
+pub fn save(
+    frame: &Frame,
+    path: &Path,
+    format: Format,
+    encoding: Encoding,
+) -> Result<(), SaveError> {
+    let bytes = encode(frame, format, encoding).map_err(|e| SaveError {
         path: path.display().to_string(),
         message: format!("cannot encode: {e}"),
     })?;

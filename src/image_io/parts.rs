@@ -14,7 +14,7 @@ use image::{Rgb32FImage, RgbImage};
 use super::{exr_bytes, to_rgb32f, to_rgb8, write_atomically, Format, SaveError};
 use crate::render::Frame;
 use crate::scene::{to_toml, Scene};
-use crate::settings::{Region, Settings};
+use crate::settings::{Encoding, Region, Settings};
 
 /// The PNG text keyword and EXR attribute name of the record.
 pub(super) const KEY: &str = "whitted-part";
@@ -31,6 +31,8 @@ pub struct Placement {
     pub height: u32,
     /// [`image_id`] of the scene and settings: parts of one image share it.
     pub image: u64,
+    /// How the image's 8-bit bytes are made (for EXR parts stitched into 8-bit files).
+    pub encoding: Encoding,
 }
 
 impl Placement {
@@ -41,14 +43,22 @@ impl Placement {
             width: settings.width,
             height: settings.height,
             image: image_id(scene, settings),
+            encoding: settings.encoding,
         }
     }
 
     pub(super) fn to_text(self) -> String {
         let r = self.region;
         format!(
-            "region={},{},{},{} image={}x{} id={:016x}",
-            r.x, r.y, r.width, r.height, self.width, self.height, self.image
+            "region={},{},{},{} image={}x{} id={:016x} encoding={}",
+            r.x,
+            r.y,
+            r.width,
+            r.height,
+            self.width,
+            self.height,
+            self.image,
+            self.encoding.name()
         )
     }
 
@@ -56,6 +66,7 @@ impl Placement {
         let mut region = None;
         let mut size = None;
         let mut id = None;
+        let mut encoding = Encoding::Linear;
         for field in text.split_whitespace() {
             let (key, value) = field.split_once('=')?;
             match key {
@@ -79,6 +90,7 @@ impl Placement {
                     size = Some((w.parse().ok()?, h.parse().ok()?));
                 }
                 "id" => id = Some(u64::from_str_radix(value, 16).ok()?),
+                "encoding" => encoding = value.parse().ok()?,
                 _ => {}
             }
         }
@@ -88,6 +100,7 @@ impl Placement {
             width,
             height,
             image: id?,
+            encoding,
         };
         let r = placement.region;
         let fits = r.width > 0
@@ -113,19 +126,21 @@ pub fn image_id(scene: &Scene, settings: &Settings) -> u64 {
     })
 }
 
-/// Saves a part with its placement: PNG and EXR only (the formats that carry it).
+/// Saves a part with its placement: PNG (bytes in `encoding`) and EXR (linear) only,
+/// the formats that carry it.
 pub fn save_part(
     frame: &Frame,
     placement: &Placement,
     path: &Path,
     format: Format,
+    encoding: Encoding,
 ) -> Result<(), SaveError> {
     let err = |message: String| SaveError {
         path: path.display().to_string(),
         message,
     };
     let bytes = match format {
-        Format::Png => png_part(&to_rgb8(frame), placement),
+        Format::Png => png_part(&to_rgb8(frame, encoding), placement),
         Format::Exr => exr_bytes(&to_rgb32f(frame), Some(placement)).map_err(|e| e.to_string()),
         _ => {
             return Err(err(

@@ -48,6 +48,8 @@ struct OutImage {
     seed: Option<u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     quality: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    encoding: Option<&'static str>,
 }
 
 #[derive(Serialize)]
@@ -154,6 +156,7 @@ pub fn to_toml(scene: &Scene) -> String {
             spp: scene.image.spp,
             seed: scene.image.seed,
             quality: scene.image.quality.map(|q| q.name()),
+            encoding: scene.image.encoding.map(|e| e.name()),
         },
         sky: OutSky {
             down: scene.sky.down.to_array(),

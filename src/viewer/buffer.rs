@@ -1,23 +1,25 @@
 //! Pixel buffers for the screen. A [`Frame`] has row 0 at the BOTTOM (`j = 0`, as in
 //! GLUT); screens have row 0 at the top, so this is where the viewer flips it, once,
-//! with the same byte conversion as the files ([`to_byte`]) so that a screenshot at
-//! 1:1 equals the saved image.
+//! with the same byte conversion as the files ([`ByteEncoder`], in the settings'
+//! encoding) so that a screenshot at 1:1 equals the saved image.
 
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::image_io::to_byte;
+use crate::image_io::{to_byte, ByteEncoder, Encoding};
 use crate::render::Frame;
 
-/// The frame as RGBA bytes, row 0 at the top, alpha 255 (the layout of `pixels`).
-/// Rows in parallel: serially the conversion costs a fifth of a full-resolution pass.
-pub fn to_rgba_top_down(frame: &Frame) -> Vec<u8> {
+/// The frame as RGBA bytes in `encoding`, row 0 at the top, alpha 255 (the layout of
+/// `pixels`). Rows in parallel: serially the conversion costs a fifth of a
+/// full-resolution pass.
+pub fn to_rgba_top_down(frame: &Frame, encoding: Encoding) -> Vec<u8> {
     let w = (frame.width as usize).max(1);
     let mut bytes = vec![0u8; frame.pixels.len() * 4];
+    let bytes_of = ByteEncoder::new(encoding);
     bytes
         .par_chunks_mut(w * 4)
         .zip(frame.pixels.par_chunks(w).rev())
-        .for_each(|(out, row)| rgba_row(row, out));
+        .for_each(|(out, row)| rgba_row(row, out, bytes_of));
     bytes
 }
 
@@ -27,11 +29,12 @@ pub fn to_rgba_top_down(frame: &Frame) -> Vec<u8> {
 /// the pass reads the 11 MB frame of 1280×720 again: 1.9 ms on two threads).
 pub struct ScreenRows<'a> {
     rows: Vec<std::sync::Mutex<&'a mut [u8]>>,
+    bytes_of: ByteEncoder,
 }
 
 impl<'a> ScreenRows<'a> {
-    /// `rgba` resized for `width`×`height`.
-    pub fn new(rgba: &'a mut Vec<u8>, width: u32, height: u32) -> Self {
+    /// `rgba` resized for `width`×`height`, to be filled in `encoding`.
+    pub fn new(rgba: &'a mut Vec<u8>, width: u32, height: u32, encoding: Encoding) -> Self {
         let w = (width as usize).max(1);
         rgba.resize(width as usize * height as usize * 4, 0);
         ScreenRows {
@@ -40,49 +43,60 @@ impl<'a> ScreenRows<'a> {
                 .rev()
                 .map(std::sync::Mutex::new)
                 .collect(),
+            bytes_of: ByteEncoder::new(encoding),
         }
     }
 
     /// Image row `j` (from the bottom) as RGBA bytes, as [`fill_for_screen`] writes it.
     pub fn put(&self, j: usize, pixels: &[Vec3]) {
         let mut row = self.rows[j].lock().unwrap_or_else(|e| e.into_inner());
-        rgba_row(pixels, &mut row);
+        rgba_row(pixels, &mut row, self.bytes_of);
     }
 }
 
 /// One row of pixels as RGBA bytes. Not inlined: compiled once, the same code for
 /// every caller (inlined, its code follows each caller's, and its cost shifts by up to
-/// a quarter with unrelated edits).
+/// a quarter with unrelated edits). One loop per encoding, each with its conversion
+/// inlined.
 #[inline(never)]
-fn rgba_row(pixels: &[Vec3], out: &mut [u8]) {
+fn rgba_row(pixels: &[Vec3], out: &mut [u8], bytes_of: ByteEncoder) {
+    match bytes_of {
+        ByteEncoder::Linear => rgba_words(pixels, out, to_byte),
+        ByteEncoder::Srgb(table) => rgba_words(pixels, out, |c| table.byte(c)),
+    }
+}
+
+#[inline(always)]
+fn rgba_words(pixels: &[Vec3], out: &mut [u8], byte: impl Fn(f32) -> u8) {
     let (out, _) = out.as_chunks_mut::<4>();
     for (o, p) in out.iter_mut().zip(pixels) {
-        *o = rgba_word(*p);
+        *o = rgba_word(*p, &byte);
     }
 }
 
 /// A pixel as RGBA bytes, alpha 255: built as one 32-bit word, so that it is stored
 /// once (the compiler then converts four pixels at a time).
 #[inline(always)]
-fn rgba_word(p: Vec3) -> [u8; 4] {
-    let [r, g, b] = [p.x, p.y, p.z].map(|c| u32::from(to_byte(c)));
+fn rgba_word(p: Vec3, byte: impl Fn(f32) -> u8) -> [u8; 4] {
+    let [r, g, b] = [p.x, p.y, p.z].map(|c| u32::from(byte(c)));
     (r | g << 8 | b << 16 | 0xff << 24).to_le_bytes()
 }
 
 /// Fills every row of `frame` (its size set beforehand) with `row(j, pixels)`, `j`
 /// counted from the bottom, and writes the same rows into `rgba` (resized to fit) as
-/// RGBA bytes, row 0 at the top, alpha 255 (the layout of `pixels`). Rows run in
-/// parallel and each row is converted while it is still in cache; the buffers may be
-/// reused ones, as every byte is written.
+/// RGBA bytes in `encoding`, row 0 at the top, alpha 255 (the layout of `pixels`).
+/// Rows run in parallel and each row is converted while it is still in cache; the
+/// buffers may be reused ones, as every byte is written.
 pub fn fill_for_screen(
     frame: &mut Frame,
     rgba: &mut Vec<u8>,
+    encoding: Encoding,
     row: impl Fn(usize, &mut [Vec3]) + Sync,
 ) {
     let w = (frame.width as usize).max(1);
     let n = frame.width as usize * frame.height as usize;
     frame.pixels.resize(n, Vec3::ZERO);
-    let screen = ScreenRows::new(rgba, frame.width, frame.height);
+    let screen = ScreenRows::new(rgba, frame.width, frame.height, encoding);
     frame
         .pixels
         .par_chunks_mut(w)
@@ -108,8 +122,10 @@ pub fn fill_upscaled_for_screen(
     rgba: &mut Vec<u8>,
     (preview, width): (&[Vec3], u32),
     factor: u32,
+    encoding: Encoding,
 ) {
     let (w, factor) = (frame.width as usize, factor.max(1) as usize);
+    let bytes_of = ByteEncoder::new(encoding);
     let n = w * frame.height as usize;
     frame.pixels.resize(n, Vec3::ZERO);
     rgba.resize(n * 4, 0);
@@ -130,7 +146,7 @@ pub fn fill_upscaled_for_screen(
             |(source, words), (block_row, (pixels, bytes))| {
                 let start = block_row.min(ph - 1) * pw;
                 crate::render::pixel_values(&preview[start..start + pw], 1, source);
-                rgba_row(source, words.as_flattened_mut());
+                rgba_row(source, words.as_flattened_mut(), bytes_of);
                 let (first, rest) = pixels.split_at_mut(w);
                 let (first_bytes, rest_bytes) = bytes.split_at_mut(w * 4);
                 // The source column advances every `factor` pixels and stops at the last.
@@ -225,7 +241,7 @@ mod tests {
 
     #[test]
     fn rgba_puts_the_bottom_row_last() {
-        let rgba = to_rgba_top_down(&frame());
+        let rgba = to_rgba_top_down(&frame(), Encoding::Linear);
         assert_eq!(rgba.len(), 3 * 2 * 4);
         // Top-left of the screen is (i=0, j=1); bottom-right is (i=2, j=0).
         assert_eq!(&rgba[0..4], &[0, 1, 255, 255]);
@@ -236,11 +252,22 @@ mod tests {
     fn rgba_equals_the_file_bytes() {
         let mut f = frame();
         f.pixels[1] = Vec3::new(-1.0, 0.5, 2.0);
-        let rgb = crate::image_io::to_rgb8(&f);
-        let rgba = to_rgba_top_down(&f);
-        for (px, chunk) in rgb.pixels().zip(rgba.chunks_exact(4)) {
-            assert_eq!(&px.0, &chunk[..3]);
-            assert_eq!(chunk[3], 255);
+        f.pixels[2] = Vec3::new(0.0031308, 0.2, 0.9);
+        for encoding in Encoding::ALL {
+            let rgb = crate::image_io::to_rgb8(&f, encoding);
+            let rgba = to_rgba_top_down(&f, encoding);
+            for (px, chunk) in rgb.pixels().zip(rgba.chunks_exact(4)) {
+                assert_eq!(&px.0, &chunk[..3]);
+                assert_eq!(chunk[3], 255);
+            }
+            // The rows a pass converts as it traces them are the same bytes.
+            let mut screen = Vec::new();
+            let rows = ScreenRows::new(&mut screen, f.width, f.height, encoding);
+            for (j, row) in f.pixels.chunks(3).enumerate() {
+                rows.put(j, row);
+            }
+            drop(rows);
+            assert_eq!(screen, rgba, "{encoding}");
         }
     }
 
@@ -251,7 +278,7 @@ mod tests {
         let mut big = Frame::new(5, 3);
         let mut rgba = Vec::new();
         let values = (preview.pixels.as_slice(), preview.width);
-        fill_upscaled_for_screen(&mut big, &mut rgba, values, 2);
+        fill_upscaled_for_screen(&mut big, &mut rgba, values, 2, Encoding::Linear);
         for (i, j, (pi, pj)) in [
             (0, 0, (0, 0)),
             (1, 1, (0, 0)),
@@ -260,26 +287,26 @@ mod tests {
         ] {
             assert_eq!(big.get(i, j), preview.get(pi, pj), "({i}, {j})");
         }
-        assert_eq!(rgba, to_rgba_top_down(&big));
+        assert_eq!(rgba, to_rgba_top_down(&big, Encoding::Linear));
         // A preview too small for the frame: its last column and row go on.
         let mut wide = Frame::new(8, 6);
-        fill_upscaled_for_screen(&mut wide, &mut rgba, values, 2);
+        fill_upscaled_for_screen(&mut wide, &mut rgba, values, 2, Encoding::Linear);
         assert_eq!(wide.get(7, 5), preview.get(2, 1));
         assert_eq!(wide.get(7, 0), preview.get(2, 0));
-        assert_eq!(rgba, to_rgba_top_down(&wide));
+        assert_eq!(rgba, to_rgba_top_down(&wide, Encoding::Linear));
         // A value that is not finite is shown (and kept for `S`) as 0.
         preview.pixels[4] = Vec3::new(f32::NAN, 0.5, f32::INFINITY);
         let values = (preview.pixels.as_slice(), preview.width);
-        fill_upscaled_for_screen(&mut big, &mut rgba, values, 2);
+        fill_upscaled_for_screen(&mut big, &mut rgba, values, 2, Encoding::Linear);
         assert_eq!(big.get(2, 2), Vec3::ZERO);
         assert_eq!(big.get(3, 2), Vec3::ZERO);
         assert_eq!(big.get(0, 2), preview.get(0, 1));
-        assert_eq!(rgba, to_rgba_top_down(&big));
+        assert_eq!(rgba, to_rgba_top_down(&big, Encoding::Linear));
     }
 
     #[test]
     fn xrgb_centres_and_clears() {
-        let rgba = to_rgba_top_down(&frame());
+        let rgba = to_rgba_top_down(&frame(), Encoding::Linear);
         let mut dst = vec![7u32; 5 * 4];
         blit_xrgb(&rgba, 3, 2, &mut dst, 5, 4);
         // Offset (1, 1): the image's top-left pixel (i=0, j=1) is at surface (1, 1).

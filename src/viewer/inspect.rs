@@ -6,7 +6,7 @@ use std::fmt::Write;
 
 use glam::{DVec3, Vec3};
 
-use crate::image_io::to_byte;
+use crate::image_io::ByteEncoder;
 use crate::scene::Scene;
 use crate::trace::reference::{RayNode, ReferenceTracer};
 
@@ -31,7 +31,9 @@ pub fn report(
     let s = (f64::from(i) + 0.5) / f64::from(width);
     let t = (f64::from(j) + 0.5) / f64::from(height);
     let (colour, tree) = tracer.inspect(s, t);
-    let bytes = [to_byte(shown.x), to_byte(shown.y), to_byte(shown.z)];
+    let bytes = shown
+        .to_array()
+        .map(|c| ByteEncoder::new(scene.settings().encoding).byte(c));
     let mut out = String::new();
     let _ = writeln!(
         out,

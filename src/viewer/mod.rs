@@ -307,11 +307,12 @@ impl App {
 
     /// Saves what is on screen under new numbered names, on a thread of its own.
     fn save(&mut self) {
-        let Some((shown, _)) = &self.shown else {
+        let Some((shown, scene)) = &self.shown else {
             println!("nothing on screen to save yet");
             return;
         };
         let frame = Arc::clone(&shown.frame);
+        let encoding = scene.settings().encoding;
         let mut what = format!(
             "{}x{}, {}/{} spp",
             frame.width, frame.height, shown.samples, shown.target
@@ -323,7 +324,7 @@ impl App {
             .numbering
             .next(Path::new(""), &self.stem, |p| p.exists());
         self.saves.push(std::thread::spawn(move || {
-            match save::save_pair(&frame, &png, &ppm) {
+            match save::save_pair(&frame, &png, &ppm, encoding) {
                 Ok(()) => println!("saved {} and {} ({what})", png.display(), ppm.display()),
                 Err(e) => eprintln!("whitted: cannot save: {e}"),
             }

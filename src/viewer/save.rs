@@ -4,7 +4,7 @@
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
-use crate::image_io::{self, Format};
+use crate::image_io::{self, Encoding, Format};
 use crate::render::Frame;
 
 /// The scene name made safe for a file name: anything but letters, digits, `-`, `_`
@@ -62,10 +62,12 @@ impl Numbering {
     }
 }
 
-/// Writes the frame to both files (each atomically); returns the paths written.
-pub fn save_pair(frame: &Frame, png: &Path, ppm: &Path) -> Result<(), String> {
-    image_io::save(frame, png, Format::Png).map_err(|e| e.to_string())?;
-    image_io::save(frame, ppm, Format::Ppm { binary: false }).map_err(|e| e.to_string())?;
+/// Writes the frame to both files (each atomically), its bytes in `encoding` (those
+/// on screen).
+pub fn save_pair(frame: &Frame, png: &Path, ppm: &Path, encoding: Encoding) -> Result<(), String> {
+    let plain = Format::Ppm { binary: false };
+    image_io::save(frame, png, Format::Png, encoding).map_err(|e| e.to_string())?;
+    image_io::save(frame, ppm, plain, encoding).map_err(|e| e.to_string())?;
     Ok(())
 }
 
@@ -107,7 +109,7 @@ mod tests {
         let mut written = Vec::new();
         for _ in 0..2 {
             let (png, ppm) = numbering.next(dir.path(), "t", |p| p.exists());
-            save_pair(&frame, &png, &ppm).unwrap();
+            save_pair(&frame, &png, &ppm, Encoding::Linear).unwrap();
             written.push((png, ppm));
         }
         assert_ne!(written[0].0, written[1].0);

@@ -337,10 +337,11 @@ fn passes<T: SampleTracer + ?Sized>(
                         &mut rgba,
                         (&buffers.preview_sums, *width),
                         *factor,
+                        opts.encoding,
                     ),
                     None => {
                         let sums = &buffers.sums;
-                        fill_for_screen(&mut frame, &mut rgba, |j, row| {
+                        fill_for_screen(&mut frame, &mut rgba, opts.encoding, |j, row| {
                             let from = &sums[j * row.len()..(j + 1) * row.len()];
                             render::pixel_values(from, samples, row);
                         });
@@ -379,7 +380,7 @@ fn trace_pass<T: SampleTracer + ?Sized>(
     control: &RenderControl,
 ) -> Result<(u32, u64, Option<(u32, u32)>), RenderError> {
     let (w, h) = (opts.width, opts.height);
-    let screen = screen.map(|rgba| ScreenRows::new(rgba, w, h));
+    let screen = screen.map(|rgba| ScreenRows::new(rgba, w, h, opts.encoding));
     let after_row = |j: u32, row: &mut [Vec3]| {
         if let Some(screen) = &screen {
             render::mend_non_finite(row);
@@ -436,6 +437,7 @@ fn trace_pass<T: SampleTracer + ?Sized>(
 mod tests {
     use super::*;
     use crate::scene::{hw3_scene, HW3_DEFAULT_SEED};
+    use crate::settings::Encoding;
     use crate::viewer::buffer::to_rgba_top_down;
     use std::sync::Mutex;
     use std::time::Duration;
@@ -484,9 +486,15 @@ mod tests {
         render::accumulate(tracer.as_ref(), &opts, 0..1, &mut sums, &Default::default()).unwrap();
         let first = render::resolve(&sums, 1, w, h);
         assert_eq!(*shown[1].frame, first);
-        assert_eq!(*shown[1].rgba, to_rgba_top_down(&shown[1].frame));
+        assert_eq!(
+            *shown[1].rgba,
+            to_rgba_top_down(&shown[1].frame, Encoding::Linear)
+        );
         assert_eq!(*shown[0].frame, expected_preview(&first, 4));
-        assert_eq!(*shown[0].rgba, to_rgba_top_down(&shown[0].frame));
+        assert_eq!(
+            *shown[0].rgba,
+            to_rgba_top_down(&shown[0].frame, Encoding::Linear)
+        );
     }
 
     /// What a preview at 1/`factor` of the size shows, from the first full pass: over
@@ -539,7 +547,11 @@ mod tests {
                 "{renderer:?}"
             );
             for s in &shown {
-                assert_eq!(*s.rgba, to_rgba_top_down(&s.frame), "{renderer:?}");
+                assert_eq!(
+                    *s.rgba,
+                    to_rgba_top_down(&s.frame, Encoding::Linear),
+                    "{renderer:?}"
+                );
             }
             // The full pass traced the pixels the preview had not.
             assert_eq!(shown[0].pass_pixels, 64 * 36);

@@ -356,7 +356,7 @@ pub fn render_with(scene: &Scene, width: u32, height: u32, renderer: Precision) 
     let non_finite = sums.iter().filter(|c| !c.is_finite()).count();
     let frame = render::resolve(&sums, 1, width, height);
     Rendered {
-        rgb: whitted::image_io::to_rgb8(&frame).into_raw(),
+        rgb: whitted::image_io::to_rgb8(&frame, whitted::image_io::Encoding::Linear).into_raw(),
         non_finite,
         seconds: start.elapsed().as_secs_f64(),
     }

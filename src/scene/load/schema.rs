@@ -104,6 +104,7 @@ pub(super) struct FileImage {
     pub(super) spp: Option<Int>,
     pub(super) seed: Option<Int>,
     pub(super) quality: Option<Spanned<String>>,
+    pub(super) encoding: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]

@@ -9,7 +9,7 @@ use super::schema::{FileAnimation, FileCamera, FileScene, FileSphere, Num, V3};
 use crate::camera::CameraSpec;
 use crate::limits;
 use crate::scene::{Animation, CameraKey, Light, Motion, Scene, SceneError, Sky, Sphere};
-use crate::settings::{Overrides, Preset, Settings, UnknownPreset};
+use crate::settings::{Encoding, Overrides, Preset, Settings, UnknownEncoding, UnknownPreset};
 
 /// Everything but the spheres, validated.
 pub(super) fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
@@ -27,6 +27,13 @@ pub(super) fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneErr
                 .parse()
                 .map_err(|e: UnknownPreset| at.at(q.span(), format!("image.quality: {e}")))?;
             image.quality = Some(preset);
+        }
+        if let Some(name) = &img.encoding {
+            let encoding: Encoding = name
+                .get_ref()
+                .parse()
+                .map_err(|e: UnknownEncoding| at.at(name.span(), format!("image.encoding: {e}")))?;
+            image.encoding = Some(encoding);
         }
         let dims = [
             (
