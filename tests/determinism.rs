@@ -8,6 +8,8 @@ use common::whitted;
 use std::path::{Path, PathBuf};
 
 use image::{GenericImageView, Rgb32FImage};
+use whitted::image_io::parts::{self, PartPixels};
+use whitted::settings::Region;
 
 /// Renders the built-in scene at 160×90 with `extra` options into `dir/name`.
 fn render(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
@@ -33,6 +35,15 @@ fn read(path: &Path) -> Vec<u8> {
 
 fn exr(path: &Path) -> Rgb32FImage {
     image::open(path).unwrap().into_rgb32f()
+}
+
+/// A region's EXR file: its pixels (the data window) and where it says they belong.
+fn exr_part(path: &Path) -> (Rgb32FImage, Region) {
+    let part = parts::read_part(path).unwrap();
+    match part.pixels {
+        PartPixels::Linear(image) => (image, part.placement.region),
+        PartPixels::Bytes(_) => panic!("an EXR part holds linear values"),
+    }
 }
 
 #[test]
@@ -91,9 +102,28 @@ fn region_equals_the_crop_of_the_whole_image() {
         let region = format!("{x},{y},{w},{h}");
         let mut args = aa.to_vec();
         args.extend(["--region", &region]);
-        let part = exr(&render(d, &format!("r-{x}-{y}-{w}-{h}.exr"), &args));
+        let file = render(d, &format!("r-{x}-{y}-{w}-{h}.exr"), &args);
+        let (part, placed) = exr_part(&file);
         assert_eq!(part.dimensions(), (w, h), "region {region}");
+        let (width, height) = (w, h);
+        assert_eq!(
+            placed,
+            Region {
+                x,
+                y,
+                width,
+                height
+            }
+        );
         let crop = full.view(x, y, w, h).to_image();
+        // Another reader (the `image` crate) shows the part in its place of the whole
+        // image: the data window inside the display window.
+        let shown = exr(&file);
+        assert_eq!(shown.dimensions(), full.dimensions(), "region {region}");
+        assert!(
+            shown.view(x, y, w, h).to_image().as_raw() == crop.as_raw(),
+            "region {region} is not shown in its place"
+        );
         let same = part
             .as_raw()
             .iter()
@@ -105,7 +135,7 @@ fn region_equals_the_crop_of_the_whole_image() {
         );
     }
     // The region's origin is the top-left, as in image tools: the top strip is sky.
-    let top = exr(&render(d, "top.exr", &["--region", "0,0,160,1"]));
+    let top = exr_part(&render(d, "top.exr", &["--region", "0,0,160,1"])).0;
     assert!(
         top.pixels().all(|p| p.0[2] > p.0[0]),
         "top strip is not sky"
