@@ -86,13 +86,16 @@ def render_tiles(
     dtype = np.float32 if linear else np.uint8
     image = np.empty((height, width, 3), dtype=dtype)
     task_options = dict(options, linear=linear)
-    scene_future = client.scatter(scene, broadcast=False)
+    # A key of its own (hash=False): a scattered value shared by key with an earlier
+    # job would be released when that job's future goes, cancelling this job's tasks.
+    scene_future = client.scatter(scene, broadcast=False, hash=False)
     futures = [
         client.submit(_render_tile, scene_future, i, count, task_options, pure=False)
         for i in range(count)
     ]
     try:
-        for done, (_, (region, part)) in enumerate(as_completed(futures, with_results=True), 1):
+        for done, future in enumerate(as_completed(futures), 1):
+            region, part = future.result()  # raises the task's error
             x, y, w, h = region
             image[y : y + h, x : x + w] = part
             if on_tile is not None:
@@ -148,10 +151,13 @@ def render_frames(
         raise ValueError("render_frames takes the frames as `frames`")
     whitted.plan(scene, **options)  # ValueError before anything is sent
     paths = {k: pattern % k for k in numbers}
-    scene_future = client.scatter(scene, broadcast=False)
+    # A key of its own (hash=False): a scattered value shared by key with an earlier
+    # job would be released when that job's future goes, cancelling this job's tasks.
+    scene_future = client.scatter(scene, broadcast=False, hash=False)
     futures = [client.submit(_render_frame, scene_future, k, options, pure=False) for k in numbers]
     try:
-        for done, (_, (k, image)) in enumerate(as_completed(futures, with_results=True), 1):
+        for done, future in enumerate(as_completed(futures), 1):
+            k, image = future.result()  # raises the task's error
             whitted.write_image(paths[k], image)
             if on_frame is not None:
                 on_frame(done, len(numbers))

@@ -12,7 +12,7 @@ use crate::settings::{Region, Settings};
 use crate::trace::RayCounts;
 
 /// Rows per unit of parallel work.
-const BAND_ROWS: usize = 8;
+pub(super) const BAND_ROWS: usize = 8;
 
 /// Runs `pixel(i, j, state, counts)` for every pixel of `area` (image pixels, `j` from
 /// the bottom) on the thread pool of `settings`. `states` holds `per_pixel` items for each

@@ -23,12 +23,12 @@ use rayon::prelude::*;
 
 use crate::camera::CameraError;
 use crate::scene::Scene;
-use crate::settings::{Precision, Settings, SettingsError};
+use crate::settings::{Adaptive, Precision, Region, Settings, SettingsError};
 use crate::trace::fast::FastTracer;
 use crate::trace::reference::ReferenceTracer;
 use crate::trace::{RayCounts, SampleTracer};
 use adaptive::adaptive;
-use bands::{for_each_pixel, for_each_row, in_pool};
+use bands::{for_each_pixel, for_each_row, in_pool, BAND_ROWS};
 use film::{centre_height, film, pixel_centres};
 
 pub use adaptive::first_pass_samples;
@@ -202,6 +202,65 @@ struct Traced {
     rays: RayCounts,
 }
 
+/// Pixels of one strip of an adaptive render at most. The first pass keeps every first
+/// sample of what it covers (16 bytes a sample: half a gigabyte for a whole 3840×2160
+/// image at 4 first samples), so an image goes through it a strip at a time, which
+/// stays in a few megabytes.
+const ADAPTIVE_STRIP_PIXELS: usize = 1 << 18;
+
+/// Adaptive anti-aliasing of the area of `settings`, in strips of whole rows of at most
+/// `strip_pixels` pixels (at least one band of rows). A strip is rendered as a region,
+/// which gives exactly that crop of the whole area (its first pass looks one pixel
+/// beyond it, as the whole area's does).
+fn adaptive_in_strips<T: SampleTracer>(
+    tracer: &T,
+    settings: &Settings,
+    a: Adaptive,
+    control: &RenderControl,
+    strip_pixels: usize,
+) -> Result<Traced, RenderError> {
+    let area = settings.area();
+    let rows = (strip_pixels / area.width.max(1) as usize).max(BAND_ROWS) as u32;
+    if rows >= area.height {
+        return adaptive(tracer, settings, a, control);
+    }
+    let n = area.width as usize * area.height as usize;
+    let mut whole = Traced {
+        frame: Frame {
+            width: area.width,
+            height: area.height,
+            pixels: vec![Vec3::ZERO; n],
+        },
+        cutoff_bound: vec![0.0; n],
+        refined: 0,
+        rays: RayCounts::default(),
+    };
+    let bottom = area.y + area.height;
+    for y in (area.y..bottom).step_by(rows as usize) {
+        let height = rows.min(bottom - y);
+        let strip = Settings {
+            region: Some(Region {
+                x: area.x,
+                y,
+                width: area.width,
+                height,
+            }),
+            tile: None,
+            ..settings.clone()
+        };
+        let part = adaptive(tracer, &strip, a, control)?;
+        // Both frames count rows from the bottom: the strip's bottom row is the
+        // area's row `bottom - (y + height)`.
+        let start = (bottom - (y + height)) as usize * area.width as usize;
+        let end = start + part.frame.pixels.len();
+        whole.frame.pixels[start..end].copy_from_slice(&part.frame.pixels);
+        whole.cutoff_bound[start..end].copy_from_slice(&part.cutoff_bound);
+        whole.refined += part.refined;
+        whole.rays.add(&part.rays);
+    }
+    Ok(whole)
+}
+
 /// The area of `settings` rendered with `tracer`.
 fn render_with<T: SampleTracer>(
     tracer: &T,
@@ -217,7 +276,9 @@ fn render_with<T: SampleTracer>(
         pixels,
     };
     match settings.quality.adaptive {
-        Some(a) if a.first < spp => adaptive(tracer, settings, a, control),
+        Some(a) if a.first < spp => {
+            adaptive_in_strips(tracer, settings, a, control, ADAPTIVE_STRIP_PIXELS)
+        }
         _ if settings.quality.cutoff == 0.0
             || settings.quality.precision == Precision::Reference =>
         {
@@ -343,6 +404,39 @@ mod tests {
             [out[0], out[1], out[2], out[3]],
             [sums[0], Vec3::ZERO, Vec3::ZERO, sums[3]]
         );
+    }
+
+    #[test]
+    fn adaptive_strips_give_the_pixels_of_one_pass() {
+        let scene = crate::scene::hw3_scene(2020);
+        let tracer = FastTracer::new(&scene, &scene.camera(96, 54).unwrap(), 5).with_cutoff(0.0);
+        let a = Adaptive::with_threshold(0.05);
+        for region in [
+            None,
+            Some(Region {
+                x: 7,
+                y: 5,
+                width: 61,
+                height: 43,
+            }),
+        ] {
+            let mut settings = scene.settings();
+            (settings.width, settings.height, settings.quality.spp) = (96, 54, 16);
+            settings.region = region;
+            let control = RenderControl::default();
+            let whole = adaptive(&tracer, &settings, a, &control).unwrap();
+            // Strips of one band (8 rows), of 17 rows, and one strip.
+            for strip_pixels in [1, 17 * 96, usize::MAX] {
+                let strips =
+                    adaptive_in_strips(&tracer, &settings, a, &control, strip_pixels).unwrap();
+                assert_eq!(strips.frame, whole.frame, "{region:?} {strip_pixels}");
+                assert_eq!(strips.cutoff_bound, whole.cutoff_bound);
+                assert_eq!(strips.refined, whole.refined);
+            }
+            // Some pixels are refined and some not: the test can tell strips apart.
+            let n = whole.frame.pixels.len() as u64;
+            assert!(whole.refined > 0 && whole.refined < n, "{}", whole.refined);
+        }
     }
 
     #[test]
