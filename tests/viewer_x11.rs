@@ -392,7 +392,8 @@ fn session(blit: &str) {
     // A click prints the pixel, counted from the bottom, and its ray tree.
     x.xdotool(&["mousemove", "--sync", "10", "170", "click", "1"]);
     viewer.wait_stdout("pixel i=10 j=9 (j from the bottom) of 320x180");
-    viewer.wait_stdout("primary  depth 0 sphere 0");
+    // Spheres counted from 1, as in scene errors: the ground is sphere 1.
+    viewer.wait_stdout("primary  depth 0 sphere 1 ");
 
     // A drag orbits (the picture changes); R brings back the scene's camera.
     x.xdotool(&["mousemove", "--sync", "160", "90", "mousedown", "1"]);

@@ -64,6 +64,7 @@ pub enum RenderError {
 pub struct RenderControl {
     cancel: AtomicBool,
     pub(crate) pixels_done: AtomicU64,
+    samples_total: AtomicU64,
 }
 
 impl RenderControl {
@@ -77,9 +78,22 @@ impl RenderControl {
         self.cancel.load(Ordering::Relaxed)
     }
 
-    /// Pixel-samples finished so far (a pixel counts once per sample pass).
+    /// Samples traced so far: the work done, in the unit of
+    /// [`RenderControl::samples_total`].
     pub fn pixels_done(&self) -> u64 {
         self.pixels_done.load(Ordering::Relaxed)
+    }
+
+    /// The samples the render will trace when it is done (0 before it starts). A
+    /// render with adaptive anti-aliasing estimates its second pass from the pixels
+    /// its first pass has flagged so far, and knows it exactly once the first pass
+    /// is over; the count never includes samples that are not traced.
+    pub fn samples_total(&self) -> u64 {
+        self.samples_total.load(Ordering::Relaxed)
+    }
+
+    pub(crate) fn set_samples_total(&self, total: u64) {
+        self.samples_total.store(total, Ordering::Relaxed);
     }
 }
 
@@ -211,6 +225,7 @@ fn render_with<T: SampleTracer>(
     let area = settings.area();
     let spp = settings.quality.spp;
     let n = area.width as usize * area.height as usize;
+    control.set_samples_total(n as u64 * u64::from(spp));
     let frame = |pixels| Frame {
         width: area.width,
         height: area.height,
