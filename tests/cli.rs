@@ -110,7 +110,10 @@ fn bad_scene_files_exit_1_naming_the_place() {
         "missing.toml",
         "[[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\n\n[[sphere]]\ncenter = [1, 0, -1]\n",
     );
-    assert_fails_with(&out, &["missing.toml:5:1: sphere 2: missing field `radius`"]);
+    assert_fails_with(
+        &out,
+        &["missing.toml:5:1: sphere 2: missing field `radius`"],
+    );
 
     // Not TOML at all.
     let (_, out) = render_scene("broken.toml", "[[sphere]\ncenter = [0, 0, -1]\n");

@@ -188,7 +188,10 @@ mod tests {
         assert!(text.contains("hit sphere 1 at"), "{text}");
         assert!(text.contains("primary  depth 0 sphere 1 "), "{text}");
         assert!(text.contains("shadow   light 1 "), "{text}");
-        assert!(!text.contains("sphere 0") && !text.contains("light 0"), "{text}");
+        assert!(
+            !text.contains("sphere 0") && !text.contains("light 0"),
+            "{text}"
+        );
         let sky = report(&scene, 64, 36, 10, 35, Vec3::ONE).unwrap();
         assert!(sky.contains("hit nothing: sky"), "{sky}");
     }
