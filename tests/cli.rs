@@ -538,3 +538,37 @@ fn time_prints_one_result_line_for_renders_and_for_orbits() {
     assert!(!out.status.success());
     assert!(stderr(&out).contains("--orbit"), "{}", stderr(&out));
 }
+
+/// README explains the stretched balls near the edges (the assignment's 132° vertical
+/// field of view) and gives one line that renders with a narrower one; that line works.
+#[test]
+fn the_readme_line_for_a_narrower_view_renders_with_vfov_60() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    assert!(
+        readme.contains("132° vertically"),
+        "README explains the stretching"
+    );
+    let line = readme
+        .lines()
+        .find(|l| l.contains("vfov = 60") && l.contains("whitted render"))
+        .expect("README gives the line");
+    let dir = tempfile::tempdir().unwrap();
+    let bin = Path::new(env!("CARGO_BIN_EXE_whitted")).parent().unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap());
+    let out = Command::new("sh")
+        .args(["-c", line])
+        .current_dir(dir.path())
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{line}: {}", stderr(&out));
+    let scene = whitted::Scene::load(&dir.path().join("narrow.toml")).unwrap();
+    match scene.camera {
+        Some(whitted::CameraSpec::LookAt { vfov, .. }) => assert_eq!(vfov, 60.0),
+        other => panic!("camera: {other:?}"),
+    }
+    assert_eq!(scene.spheres.len(), 52);
+    let image = image::open(dir.path().join("narrow.png")).unwrap();
+    assert_eq!((image.width(), image.height()), (1280, 720));
+}
