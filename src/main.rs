@@ -91,7 +91,11 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
         Err(e) => {
-            eprintln!("{}", usage_error_line(&e));
+            let subcommand = std::env::args().nth(1);
+            eprintln!(
+                "whitted: error: {}",
+                usage_error_line(&e, subcommand.as_deref())
+            );
             return ExitCode::from(2);
         }
     };
@@ -126,22 +130,66 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("whitted: error: {}", one_line(&e));
-            ExitCode::from(1)
+            // Bad option values are usage errors, like those clap finds.
+            ExitCode::from(if cli::is_usage_error(&e) { 2 } else { 1 })
         }
     }
 }
 
 /// clap's message on one line, like every other error: the error itself and its hints
-/// (a similar option, the possible values), without the usage block.
-fn usage_error_line(e: &clap::Error) -> String {
+/// (a similar option, the possible values), without the usage block and without
+/// clap's "error: " (the caller puts whitted's). `subcommand` is the first argument.
+fn usage_error_line(e: &clap::Error, subcommand: Option<&str>) -> String {
+    if let Some(line) = viewer_option_line(e, subcommand) {
+        return format!("{line} (see --help)");
+    }
     let text = e.to_string();
     let parts: Vec<&str> = text
         .lines()
         .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
         .map(str::trim)
-        .filter(|l| !l.is_empty())
+        // "to pass '--width' as a value, use '-- --width'" only ever fits a scene file
+        // named like an option; for a mistyped or misplaced option it misleads.
+        .filter(|l| !l.is_empty() && !l.starts_with("tip: to pass"))
         .collect();
-    format!("{} (see --help)", parts.join("; "))
+    let line = parts.join("; ");
+    let line = line.strip_prefix("error: ").unwrap_or(&line);
+    format!("{line} (see --help)")
+}
+
+/// For an option of `whitted render` given to the viewer (`whitted view --width 640`,
+/// or `whitted --spp 4`): what to do instead.
+fn viewer_option_line(e: &clap::Error, subcommand: Option<&str>) -> Option<String> {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    let viewer = match subcommand {
+        Some("view") => "whitted view",
+        Some(arg) if arg.starts_with('-') => "whitted",
+        _ => return None,
+    };
+    if e.kind() != ErrorKind::UnknownArgument {
+        return None;
+    }
+    let Some(ContextValue::String(arg)) = e.get(ContextKind::InvalidArg) else {
+        return None;
+    };
+    let option = arg.split('=').next().unwrap_or(arg);
+    let instead = match option {
+        "--width" | "--height" => format!(
+            "the window is resizable, or set {} in the scene's [image] table",
+            &option[2..]
+        ),
+        "--spp" | "--seed" => format!(
+            "set {} in the scene's [image] table, or use --quality",
+            &option[2..]
+        ),
+        "--depth" => "set max_depth in the scene's [image] table, or use --quality".into(),
+        "-o" | "--output" | "--region" | "--tile" | "--threads" | "--reference" | "--quiet"
+        | "-q" | "--ppm-binary" | "--frames" | "--frame" | "--orbit" => {
+            "it is an option of `whitted render`".to_string()
+        }
+        _ => return None,
+    };
+    Some(format!("`{viewer}` takes no {option}: {instead}"))
 }
 
 /// The error and its causes on one line.

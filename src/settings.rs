@@ -469,7 +469,9 @@ impl Settings {
     }
 
     /// Checks sizes, samples, depth, the region and the threads against [`crate::limits`]
-    /// before anything is allocated.
+    /// before anything is allocated. What a render allocates is its area (the region,
+    /// the tile or the whole image): the area is held to [`MAX_PIXELS`], the whole
+    /// image's sides to [`MAX_SIDE`].
     pub fn check(&self) -> Result<(), SettingsError> {
         let (width, height) = (self.width, self.height);
         if width == 0 || height == 0 {
@@ -477,9 +479,6 @@ impl Settings {
         }
         if width > MAX_SIDE || height > MAX_SIDE {
             return Err(SettingsError::SideTooLong { width, height });
-        }
-        if u64::from(width) * u64::from(height) > MAX_PIXELS {
-            return Err(SettingsError::TooManyPixels { width, height });
         }
         self.quality.check()?;
         if let Some(r) = self.region {
@@ -507,11 +506,39 @@ impl Settings {
                 });
             }
         }
+        let area = self.area();
+        if u64::from(area.width) * u64::from(area.height) > MAX_PIXELS {
+            return Err(match (self.region, self.tile) {
+                (None, None) => SettingsError::TooManyPixels { width, height },
+                (_, tile) => SettingsError::AreaTooLarge { area, tile },
+            });
+        }
         if self.threads == Some(0) {
             return Err(SettingsError::NoThreads);
         }
         Ok(())
     }
+}
+
+/// What fits where a region does not: the largest region at its origin, or where its
+/// origin may be.
+fn what_fits(region: &Region, width: u32, height: u32) -> String {
+    if region.x >= width || region.y >= height {
+        format!("its corner must be inside, at X below {width} and Y below {height}")
+    } else {
+        format!(
+            "the largest region at {},{} is {}x{}",
+            region.x,
+            region.y,
+            width - region.x,
+            height - region.y
+        )
+    }
+}
+
+/// The tallest image of `width` columns within [`MAX_PIXELS`].
+fn tallest(width: u32) -> u64 {
+    (MAX_PIXELS / u64::from(width.max(1))).min(u64::from(MAX_SIDE))
 }
 
 /// Settings that [`Settings::check`] refuses.
@@ -533,13 +560,30 @@ pub enum SettingsError {
         /// Height asked for.
         height: u32,
     },
-    /// More than [`MAX_PIXELS`] pixels.
-    #[error("image size {width}x{height} is too large: at most {MAX_PIXELS} pixels")]
+    /// A whole image of more than [`MAX_PIXELS`] pixels.
+    #[error(
+        "image size {width}x{height} is too large: at most {MAX_PIXELS} pixels in one render \
+         ({width}x{} at this width); render it in parts, a region or a tile at a time",
+        tallest(*width)
+    )]
     TooManyPixels {
         /// Width asked for.
         width: u32,
         /// Height asked for.
         height: u32,
+    },
+    /// A region or tile of more than [`MAX_PIXELS`] pixels.
+    #[error(
+        "{} is {}x{}, too large: at most {MAX_PIXELS} pixels in one render ({}x{} at this width)",
+        tile.map_or(format!("region {},{},{},{}", area.x, area.y, area.width, area.height),
+            |t| format!("tile {}/{}", t.index, t.count)),
+        area.width, area.height, area.width, tallest(area.width)
+    )]
+    AreaTooLarge {
+        /// The rectangle asked for.
+        area: Region,
+        /// The tile it is, if it is one.
+        tile: Option<Tile>,
     },
     /// Samples per pixel of 0 or beyond [`MAX_SPP`].
     #[error("spp {0} is out of range: expected 1 to {MAX_SPP}")]
@@ -558,8 +602,8 @@ pub enum SettingsError {
     AdaptiveFirst,
     /// A region that is empty or reaches outside the image.
     #[error(
-        "region {},{},{},{} does not fit in the {width}x{height} image",
-        region.x, region.y, region.width, region.height
+        "region {},{},{},{} does not fit in the {width}x{height} image: {}",
+        region.x, region.y, region.width, region.height, what_fits(region, *width, *height)
     )]
     RegionOutside {
         /// The region asked for.
@@ -698,7 +742,8 @@ mod tests {
         );
         assert_eq!(
             bad(&|s| (s.width, s.height) = (MAX_SIDE, MAX_SIDE)),
-            "image size 65536x65536 is too large: at most 268435456 pixels"
+            "image size 65536x65536 is too large: at most 268435456 pixels in one render \
+             (65536x4096 at this width); render it in parts, a region or a tile at a time"
         );
         assert_eq!(
             bad(&|s| s.quality.spp = 0),
@@ -723,9 +768,79 @@ mod tests {
                 width: 81,
                 height: 20
             })),
-            "region 1200,700,81,20 does not fit in the 1280x720 image"
+            "region 1200,700,81,20 does not fit in the 1280x720 image: the largest region \
+             at 1200,700 is 80x20"
+        );
+        assert_eq!(
+            bad(&|s| s.region = Some(Region {
+                x: 1280,
+                y: 0,
+                width: 1,
+                height: 1
+            })),
+            "region 1280,0,1,1 does not fit in the 1280x720 image: its corner must be \
+             inside, at X below 1280 and Y below 720"
         );
         assert_eq!(bad(&|s| s.threads = Some(0)), "threads must be at least 1");
+    }
+
+    #[test]
+    fn the_pixel_limit_holds_for_what_is_rendered_and_the_sides_for_the_image() {
+        let huge = |region, tile| Settings {
+            width: MAX_SIDE,
+            height: MAX_SIDE,
+            region,
+            tile,
+            ..Settings::default()
+        };
+        let small = Region {
+            x: 0,
+            y: 0,
+            width: 64,
+            height: 64,
+        };
+        assert_eq!(huge(Some(small), None).check(), Ok(()));
+        // 65536 tiles of 256x256.
+        assert_eq!(
+            huge(
+                None,
+                Some(Tile {
+                    index: 7,
+                    count: 1 << 16
+                })
+            )
+            .check(),
+            Ok(())
+        );
+        let half = Region {
+            x: 0,
+            y: 0,
+            width: MAX_SIDE,
+            height: MAX_SIDE / 2,
+        };
+        assert_eq!(
+            huge(Some(half), None).check().unwrap_err().to_string(),
+            "region 0,0,65536,32768 is 65536x32768, too large: at most 268435456 pixels \
+             in one render (65536x4096 at this width)"
+        );
+        assert_eq!(
+            huge(None, Some(Tile { index: 0, count: 4 }))
+                .check()
+                .unwrap_err()
+                .to_string(),
+            "tile 0/4 is 32768x32768, too large: at most 268435456 pixels in one render \
+             (32768x8192 at this width)"
+        );
+        // The sides of the whole image stay bounded, region or not.
+        let mut long = huge(Some(small), None);
+        long.width = MAX_SIDE + 1;
+        assert_eq!(
+            long.check(),
+            Err(SettingsError::SideTooLong {
+                width: MAX_SIDE + 1,
+                height: MAX_SIDE
+            })
+        );
     }
 
     #[test]

@@ -531,13 +531,13 @@ fn animation_options_override_the_scene_and_bad_ones_say_why() {
     let with = |extra: &[&'static str]| [&small[..], extra].concat();
     fails(
         &with(&["--frames", "4", "-o", "x.png"]),
-        1,
+        2,
         "one image cannot hold 4 frames",
     );
-    fails(&with(&["--frames", "4"]), 1, "name the files with -o");
+    fails(&with(&["--frames", "4"]), 2, "name the files with -o");
     fails(
         &with(&["--frames", "4", "--frame", "4", "-o", "x.png"]),
-        1,
+        2,
         "has 4 frames (0 to 3)",
     );
     fails(&with(&["--frame", "3..1", "-o", "x.png"]), 2, "A < B");

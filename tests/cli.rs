@@ -105,6 +105,16 @@ fn bad_scene_files_exit_1_naming_the_place() {
     );
     assert_fails_with(&out, &["weight.toml:8:11", "sphere 2", "reflect"]);
 
+    // A missing key names the sphere, counted from 1 like the others.
+    let (_, out) = render_scene(
+        "missing.toml",
+        "[[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\n\n[[sphere]]\ncenter = [1, 0, -1]\n",
+    );
+    assert_fails_with(
+        &out,
+        &["missing.toml:5:1: sphere 2: missing field `radius`"],
+    );
+
     // Not TOML at all.
     let (_, out) = render_scene("broken.toml", "[[sphere]\ncenter = [0, 0, -1]\n");
     assert_fails_with(&out, &["broken.toml:1:"]);
@@ -145,7 +155,7 @@ fn usage_errors_exit_2() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
         // One line, like every other error.
         let err = stderr(&out);
-        assert!(err.starts_with("error: "), "{args:?}: {err}");
+        assert!(err.starts_with("whitted: error: "), "{args:?}: {err}");
         assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
     }
     // The hints stay on that line: a similar option, the possible values.
@@ -164,8 +174,165 @@ fn usage_errors_exit_2() {
     }
 }
 
+/// The exact line of a usage error (exit status 2).
+#[track_caller]
+fn assert_usage_error(args: &[&str], line: &str) {
+    let out = whitted(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+    assert_eq!(
+        stderr(&out),
+        format!("whitted: error: {line}\n"),
+        "{args:?}"
+    );
+}
+
 #[test]
-fn a_region_outside_the_image_exits_1() {
+fn misplaced_options_and_negative_numbers_say_what_is_wrong() {
+    // An option of `render` given to the viewer: no "use '-- --width'" tip.
+    assert_usage_error(
+        &["view", "--width", "640"],
+        "`whitted view` takes no --width: the window is resizable, or set width in the \
+         scene's [image] table (see --help)",
+    );
+    assert_usage_error(
+        &["--spp", "4"],
+        "`whitted` takes no --spp: set spp in the scene's [image] table, or use --quality \
+         (see --help)",
+    );
+    assert_usage_error(
+        &["view", "-o", "x.png"],
+        "`whitted view` takes no -o: it is an option of `whitted render` (see --help)",
+    );
+    // A negative number is a bad value, not an unknown option.
+    assert_usage_error(
+        &["render", "--spp", "-1"],
+        "invalid value '-1' for '--spp <SPP>': expected a whole number from 1 to 65536 \
+         (see --help)",
+    );
+    assert_usage_error(
+        &["render", "--depth", "-3"],
+        "invalid value '-3' for '--depth <DEPTH>': expected a whole number from 0 to 64 \
+         (see --help)",
+    );
+    let out = whitted(&["render", "--seed", "-1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!stderr(&out).contains("tip: to pass"), "{}", stderr(&out));
+}
+
+/// README's rule: a bad option value is a usage error (exit status 2) whether clap or
+/// the settings find it, and the line says what would fit.
+#[test]
+fn option_values_that_do_not_fit_exit_2_saying_what_would() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("out.png");
+    let png = png.to_str().unwrap();
+    assert_usage_error(
+        &["render", "--region", "1200,700,200,200", "-o", png],
+        "region 1200,700,200,200 does not fit in the 1280x720 image: the largest region at \
+         1200,700 is 80x20",
+    );
+    assert_usage_error(
+        &[
+            "render",
+            "--width",
+            "50",
+            "--height",
+            "50",
+            "--region",
+            "50,0,10,10",
+            "-o",
+            png,
+        ],
+        "region 50,0,10,10 does not fit in the 50x50 image: its corner must be inside, at X \
+         below 50 and Y below 50",
+    );
+    assert_usage_error(
+        &["render", "--width", "65536", "--height", "65536", "-o", png],
+        "image size 65536x65536 is too large: at most 268435456 pixels in one render \
+         (65536x4096 at this width); render it in parts, a region or a tile at a time",
+    );
+    assert_usage_error(
+        &["render", "--width", "100000", "-o", png],
+        "invalid value '100000' for '--width <WIDTH>': expected a whole number from 1 to \
+         65536 (see --help)",
+    );
+    assert_usage_error(
+        &[
+            "render", "--tile", "8/9", "--width", "2", "--height", "2", "-o", png,
+        ],
+        "tile 8/9 does not exist in a 2x2 image: expected an index from 0 to 8 and at most \
+         as many tiles as pixels",
+    );
+    assert!(entries(dir.path()).is_empty());
+}
+
+/// Only the region is allocated: a 64x64 corner of a 65536x65536 image renders (within
+/// 1 GB of address space; the whole image's pixels would take 51 GB).
+#[test]
+fn a_small_region_of_a_giant_image_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("corner.png");
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(r#"ulimit -v 1048576 && exec "$@""#)
+        .arg("sh")
+        .arg(env!("CARGO_BIN_EXE_whitted"))
+        .args(["render", "--width", "65536", "--height", "65536"])
+        .args(["--region", "0,0,64,64", "--threads", "2", "-o"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let image = image::open(&png).unwrap();
+    assert_eq!((image.width(), image.height()), (64, 64));
+}
+
+/// The closing line of `render` (the last line on stderr).
+fn closing_line(args: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("out.png");
+    let out = whitted(&[args, &["-o", png.to_str().unwrap()]].concat());
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    stderr(&out).lines().last().unwrap_or_default().to_string()
+}
+
+#[test]
+fn the_closing_line_says_how_many_samples_adaptive_anti_aliasing_took() {
+    let size = ["render", "--width", "64", "--height", "36"];
+    let line = closing_line(&[&size[..], &["--quality", "high"]].concat());
+    // e.g. "rendered hw3 64x36 (adaptive, up to 64 spp, mean 9.3, depth 16) in ..."
+    let rest = line
+        .strip_prefix("rendered hw3 64x36 (adaptive, up to 64 spp, mean ")
+        .unwrap_or_else(|| panic!("closing line: {line}"));
+    let (mean, rest) = rest.split_once(", ").unwrap();
+    let mean: f64 = mean.parse().unwrap();
+    assert!(mean > 4.0 && mean < 64.0, "{line}");
+    assert!(rest.starts_with("depth 16) in "), "{line}");
+    // A fixed number of samples is said as it is.
+    let line = closing_line(&[&size[..], &["--spp", "16"]].concat());
+    assert!(
+        line.starts_with("rendered hw3 64x36 (16 spp, depth 5) in "),
+        "{line}"
+    );
+}
+
+/// Depth 0 traces no ray (SPEC §2: `trace` returns the sky at `max_depth`): allowed,
+/// written, and said in the closing line.
+#[test]
+fn depth_0_renders_the_sky_and_says_so() {
+    let line = closing_line(&["render", "--width", "64", "--height", "36", "--depth", "0"]);
+    assert!(
+        line.starts_with(
+            "rendered hw3 64x36 (1 spp, depth 0: no ray traced, every pixel is the sky) in "
+        ) && line.contains(": 0 rays, "),
+        "{line}"
+    );
+    let help = String::from_utf8_lossy(&whitted(&["render", "--help"]).stdout).into_owned();
+    assert!(help.contains("0 traces no ray at all"), "{help}");
+}
+
+#[test]
+fn a_region_outside_the_image_exits_2() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("out.png");
     let out = whitted(&[
@@ -179,7 +346,8 @@ fn a_region_outside_the_image_exits_1() {
         "-o",
         png.to_str().unwrap(),
     ]);
-    assert_fails_with(&out, &["region", "50x50"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("50x50 image"), "{}", stderr(&out));
     assert!(entries(dir.path()).is_empty());
 }
 
@@ -369,4 +537,38 @@ fn time_prints_one_result_line_for_renders_and_for_orbits() {
     let out = whitted(&["time", scene, "--no-preview"]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("--orbit"), "{}", stderr(&out));
+}
+
+/// README explains the stretched balls near the edges (the assignment's 132° vertical
+/// field of view) and gives one line that renders with a narrower one; that line works.
+#[test]
+fn the_readme_line_for_a_narrower_view_renders_with_vfov_60() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    assert!(
+        readme.contains("132° vertically"),
+        "README explains the stretching"
+    );
+    let line = readme
+        .lines()
+        .find(|l| l.contains("vfov = 60") && l.contains("whitted render"))
+        .expect("README gives the line");
+    let dir = tempfile::tempdir().unwrap();
+    let bin = Path::new(env!("CARGO_BIN_EXE_whitted")).parent().unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap());
+    let out = Command::new("sh")
+        .args(["-c", line])
+        .current_dir(dir.path())
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{line}: {}", stderr(&out));
+    let scene = whitted::Scene::load(&dir.path().join("narrow.toml")).unwrap();
+    match scene.camera {
+        Some(whitted::CameraSpec::LookAt { vfov, .. }) => assert_eq!(vfov, 60.0),
+        other => panic!("camera: {other:?}"),
+    }
+    assert_eq!(scene.spheres.len(), 52);
+    let image = image::open(dir.path().join("narrow.png")).unwrap();
+    assert_eq!((image.width(), image.height()), (1280, 720));
 }

@@ -210,12 +210,12 @@ fn bad_tiles_are_usage_errors() {
         2,
         "cannot be used with",
     );
-    // More tiles than the image has rows and columns for.
+    // More tiles than the image has rows and columns for: a bad option value too.
     fails(
         &[
             "render", "--tile", "0/7", "--width", "2", "--height", "3", "-o", "x.png",
         ],
-        1,
+        2,
         "does not exist in a 2x3 image",
     );
 }

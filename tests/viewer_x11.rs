@@ -3,8 +3,9 @@
 //! `whitted render` writes; keys are real key presses (XTEST via `xdotool key` to the
 //! focused window), since winit ignores synthetic events.
 //!
-//! The tests need `Xvfb`, `xdotool` and ImageMagick's `import`; without them they say
-//! so loudly on stderr and pass (CI always has them: see `.ci/run`).
+//! The tests need `Xvfb`, `xdotool` and ImageMagick's `import`. Without them a test is
+//! skipped with a line the test harness shows (written past its output capture); with
+//! `CI=true` (CI always has them: see `.ci/run`) a missing tool fails the test.
 #![cfg(all(feature = "cli", feature = "viewer"))]
 
 use std::fs;
@@ -22,7 +23,9 @@ fn have(tool: &str) -> bool {
         .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(tool).is_file()))
 }
 
-/// Whether the X tools are installed; if not, says loudly that `test` is skipped.
+/// Whether the X tools are installed. If not, `test` fails under `CI=true`; else it
+/// is skipped, and a line says so on the harness's own stderr (not through
+/// `eprintln!`, whose output the harness keeps to itself for a passing test).
 fn x_tools_or_skip(test: &str) -> bool {
     let missing: Vec<&str> = ["Xvfb", "xdotool", "import"]
         .into_iter()
@@ -31,10 +34,17 @@ fn x_tools_or_skip(test: &str) -> bool {
     if missing.is_empty() {
         return true;
     }
-    eprintln!(
-        "\n*** SKIPPED {test}: {} not installed (apt-get install xvfb xdotool imagemagick); \
-         the viewer was NOT tested ***\n",
+    let what = format!(
+        "{test}: {} not installed (apt-get install xvfb xdotool imagemagick)",
         missing.join(", ")
+    );
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!("{what}; CI=true, so the viewer must be tested");
+    }
+    use std::io::Write;
+    let _ = writeln!(
+        std::io::stderr(),
+        "SKIPPED {what}: the viewer was NOT tested"
     );
     false
 }
@@ -183,9 +193,34 @@ impl XServer {
     }
 }
 
+impl XServer {
+    /// The display's lock file and socket, which a server removes when it stops.
+    fn files(&self) -> [PathBuf; 2] {
+        let number = &self.display[1..];
+        [
+            PathBuf::from(format!("/tmp/.X{number}-lock")),
+            PathBuf::from(format!("/tmp/.X11-unix/X{number}")),
+        ]
+    }
+}
+
+/// Stops the server with SIGTERM and waits for it, so that it removes its lock file
+/// and socket; also when a test fails (a panic unwinds through here). SIGKILL only if
+/// it has not stopped after 10 seconds.
 impl Drop for XServer {
     fn drop(&mut self) {
-        let _ = self.child.kill();
+        if let Ok(None) = self.child.try_wait() {
+            // SAFETY: kill(2) on our own child, whose pid is not yet reaped.
+            unsafe { libc::kill(self.child.id() as libc::pid_t, libc::SIGTERM) };
+            let start = Instant::now();
+            while let Ok(None) = self.child.try_wait() {
+                if start.elapsed() > Duration::from_secs(10) {
+                    let _ = self.child.kill();
+                    break;
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        }
         let _ = self.child.wait();
     }
 }
@@ -356,6 +391,16 @@ fn session(blit: &str) {
         title.starts_with("whitted - small - 320x180 - 1/1 spp - "),
         "title: {title}"
     );
+    // One line names the blitter, whichever it is.
+    let line = format!("whitted: drawing with {blit}");
+    assert!(
+        viewer
+            .stderr()
+            .lines()
+            .any(|l| l.starts_with(&line) && l.ends_with(&format!("(WHITTED_BLIT={blit})"))),
+        "no `{line}` line: {}",
+        viewer.stderr()
+    );
     // WHITTED_STATS names the blitter that drew the first frame.
     assert!(
         viewer
@@ -392,7 +437,8 @@ fn session(blit: &str) {
     // A click prints the pixel, counted from the bottom, and its ray tree.
     x.xdotool(&["mousemove", "--sync", "10", "170", "click", "1"]);
     viewer.wait_stdout("pixel i=10 j=9 (j from the bottom) of 320x180");
-    viewer.wait_stdout("primary  depth 0 sphere 0");
+    // Spheres counted from 1, as in scene errors: the ground is sphere 1.
+    viewer.wait_stdout("primary  depth 0 sphere 1 ");
 
     // A drag orbits (the picture changes); R brings back the scene's camera.
     x.xdotool(&["mousemove", "--sync", "160", "90", "mousedown", "1"]);
@@ -729,4 +775,81 @@ fn without_a_display_it_says_so_and_exits_1() {
         "{stderr}"
     );
     assert!(!stderr.contains(".rs:"), "no source locations: {stderr}");
+}
+
+/// Without the X tools the tests are skipped where the harness shows it, and under
+/// `CI=true` they fail. Runs this test binary again on one test, with no X tool on
+/// PATH.
+#[test]
+fn a_missing_x_tool_is_a_visible_skip_or_a_ci_failure() {
+    let empty = tempfile::tempdir().unwrap();
+    let run = |ci: &str| {
+        Command::new(std::env::current_exe().unwrap())
+            .args(["--exact", "session_with_softbuffer", "--test-threads", "1"])
+            .env("PATH", empty.path())
+            .env("CI", ci)
+            .output()
+            .unwrap()
+    };
+    let skipped = run("");
+    let stderr = String::from_utf8_lossy(&skipped.stderr);
+    assert!(skipped.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(
+            "SKIPPED viewer session with WHITTED_BLIT=softbuffer: Xvfb, xdotool, import not \
+             installed"
+        ),
+        "no visible skip: {stderr}"
+    );
+    let failed = run("true");
+    let stdout = String::from_utf8_lossy(&failed.stdout);
+    assert!(!failed.status.success(), "{stdout}");
+    assert!(
+        stdout.contains("CI=true, so the viewer must be tested"),
+        "{stdout}"
+    );
+}
+
+/// A server stopped by its guard removes its lock file and socket, also when the test
+/// that started it fails.
+#[test]
+fn x_servers_leave_no_lock_file_or_socket() {
+    if !x_tools_or_skip("X server clean-up test") {
+        return;
+    }
+    let x = XServer::start();
+    let files = x.files();
+    assert!(files.iter().all(|f| f.exists()), "{files:?}");
+    drop(x);
+    for f in &files {
+        assert!(!f.exists(), "{} is left behind", f.display());
+    }
+    let files = std::panic::catch_unwind(|| {
+        let x = XServer::start();
+        let files = x.files();
+        std::panic::panic_any(files);
+    })
+    .unwrap_err()
+    .downcast::<[PathBuf; 2]>()
+    .unwrap();
+    for f in files.iter() {
+        assert!(!f.exists(), "after a panic, {} is left behind", f.display());
+    }
+}
+
+/// Without `XDG_RUNTIME_DIR`, the window opens with `pixels` (Vulkan) and stderr holds
+/// only whitted's own lines: no "XDG_RUNTIME_DIR is invalid" from libwayland.
+#[test]
+fn without_xdg_runtime_dir_the_window_says_nothing_of_it() {
+    let env = [("WHITTED_BLIT", "pixels"), ("XDG_RUNTIME_DIR", "")];
+    let Some(stderr) = shows_the_render_with("XDG_RUNTIME_DIR test", &env) else {
+        return;
+    };
+    assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
+    for line in stderr.lines() {
+        assert!(
+            line.starts_with("whitted: ") || line.starts_with("stats: "),
+            "a line not in whitted's voice: {line}"
+        );
+    }
 }

@@ -17,10 +17,11 @@ use std::sync::mpsc::{sync_channel, Receiver};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use anyhow::{anyhow, bail, Context};
+use anyhow::{anyhow, Context};
 use clap::Args;
 use image::RgbImage;
 
+use super::usage;
 use whitted::image_io::{self, AnimatedFormat, AnimatedWriter, Format};
 use whitted::limits::MAX_FRAMES;
 use whitted::render::{Frame, RenderControl, RenderError, Sequence};
@@ -194,7 +195,7 @@ pub(crate) fn render_frames(
         end: frames,
     });
     if range.end > frames {
-        bail!(
+        return Err(usage(format!(
             "--frame {}: the scene has {frames} frame{} (0 to {})",
             if range.end == range.start + 1 {
                 range.start.to_string()
@@ -203,7 +204,7 @@ pub(crate) fn render_frames(
             },
             if frames == 1 { "" } else { "s" },
             frames - 1
-        );
+        )));
     }
     let count = range.end - range.start;
     let defaults = [PathBuf::from("output.ppm"), PathBuf::from("output.png")];
@@ -213,10 +214,10 @@ pub(crate) fn render_frames(
         outputs
     };
     if outputs.is_empty() {
-        bail!(
+        return Err(usage(format!(
             "{count} frames to render: name the files with -o (a pattern such as \
              frames/f-%04d.png, or a .gif or .apng file)"
-        );
+        )));
     }
     settings.check()?;
     let area = settings.area();
@@ -225,11 +226,13 @@ pub(crate) fn render_frames(
     for path in outputs {
         let output = Output::of(path, ppm_binary).map_err(|e| anyhow!(e))?;
         match &output {
-            Output::Still(path, _) if count > 1 => bail!(
-                "{}: one image cannot hold {count} frames: use a pattern such as \
-                 f-%04d.png for numbered files, or a .gif or .apng file",
-                path.display()
-            ),
+            Output::Still(path, _) if count > 1 => {
+                return Err(usage(format!(
+                    "{}: one image cannot hold {count} frames: use a pattern such as \
+                     f-%04d.png for numbered files, or a .gif or .apng file",
+                    path.display()
+                )))
+            }
             Output::Still(path, _) | Output::Animated(path, _) => image_io::check_writable(path)?,
             Output::Numbered(pattern, _) => image_io::check_writable(&pattern.path(range.start))?,
         }
@@ -274,6 +277,7 @@ pub(crate) fn render_frames(
     let start = Instant::now();
     let mut sequence = Sequence::new(&scene);
     let mut rays = 0u64;
+    let mut samples = 0u64;
     let mut stopped: Option<anyhow::Error> = None;
     for k in range.start..range.end {
         let camera = scene.frame_camera_spec(k, settings.width, settings.height);
@@ -289,6 +293,7 @@ pub(crate) fn render_frames(
             }
         };
         rays += stats.rays.total();
+        samples += stats.rays.primary;
         let finished = Finished {
             k,
             rgb: image_io::to_rgb8(&frame, settings.encoding),
@@ -341,13 +346,12 @@ pub(crate) fn render_frames(
             format!("frames {}..{}", range.start, range.end)
         };
         eprintln!(
-            "rendered {} {frames} at {}x{} ({} spp, depth {}) in {:.3} s: \
+            "rendered {} {frames} at {}x{} ({}) in {:.3} s: \
              {rays} rays, {:.1} Mrays/s",
             scene.name,
             area.width,
             area.height,
-            settings.quality.spp,
-            settings.quality.max_depth,
+            super::render::sampling(&settings.quality, samples / u64::from(count), area),
             seconds,
             rays as f64 / seconds.max(1e-9) / 1e6
         );

@@ -13,6 +13,36 @@ use anyhow::Context;
 use whitted::scene::{self, Scene};
 use whitted::settings::Overrides;
 
+/// An option's value that the command line cannot honour (a frame the scene lacks,
+/// a region outside the image): a usage error like clap's own, exit status 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub(crate) struct UsageError(pub(crate) String);
+
+/// A [`UsageError`] saying `message`.
+pub(crate) fn usage(message: String) -> anyhow::Error {
+    anyhow::Error::new(UsageError(message))
+}
+
+/// Whether `e` is a usage error (exit status 2): a [`UsageError`], or settings from
+/// the command line that [`whitted::settings::Settings::check`] refuses (the scene
+/// file's own settings are checked, with their place, when it loads).
+pub(crate) fn is_usage_error(e: &anyhow::Error) -> bool {
+    e.downcast_ref::<UsageError>().is_some()
+        || e.downcast_ref::<whitted::settings::SettingsError>()
+            .is_some()
+}
+
+/// The parser of a whole-number option from `lo` to `hi` whose error says what is
+/// wanted ("expected a whole number from 1 to 65536"), also for a negative number
+/// (which clap would otherwise take for an unknown option).
+pub(crate) fn whole_number(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, String> + Clone {
+    move |text| match text.trim().parse::<i128>() {
+        Ok(n) if (i128::from(lo)..=i128::from(hi)).contains(&n) => Ok(n as u32),
+        _ => Err(format!("expected a whole number from {lo} to {hi}")),
+    }
+}
+
 /// The built-in scene, embedded from the file the generator wrote
 /// (`whitted scene hw3 > assets/scenes/hw3.toml`); a test keeps the two in step.
 pub(crate) const BUILTIN_SCENE: &str = include_str!("../../assets/scenes/hw3.toml");

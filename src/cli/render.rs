@@ -12,10 +12,11 @@ use clap::Args;
 use whitted::image_io::parts::{self, Placement};
 use whitted::image_io::{self, Format};
 use whitted::render::{self, RenderControl};
-use whitted::settings::{Encoding, Overrides, Precision, Preset, Region, Tile};
+use whitted::settings::{Encoding, Overrides, Precision, Preset, Quality, Region, Tile};
 
 use super::animate::{self, FrameOptions};
-use super::load_scene;
+use super::{load_scene, whole_number};
+use whitted::limits::{MAX_DEPTH, MAX_SIDE, MAX_SPP};
 
 #[derive(Args)]
 pub(crate) struct RenderArgs {
@@ -30,22 +31,24 @@ pub(crate) struct RenderArgs {
     #[arg(long)]
     ppm_binary: bool,
     /// Image width in pixels (overrides the scene's).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_number(1, MAX_SIDE))]
     width: Option<u32>,
     /// Image height in pixels (overrides the scene's).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_number(1, MAX_SIDE))]
     height: Option<u32>,
     /// Samples per pixel.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_number(1, MAX_SPP))]
     spp: Option<u32>,
-    /// Maximum ray depth.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
+    /// Maximum ray depth: 1 traces the rays from the eye only, 5 (the default) four
+    /// bounces of reflection and refraction. 0 traces no ray at all: every pixel is the
+    /// sky seen in its direction (SPEC §2: `trace` returns the sky at `max_depth`).
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_number(0, MAX_DEPTH))]
     depth: Option<u32>,
     /// Sampling seed.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     seed: Option<u64>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole_number(1, 1024))]
     threads: Option<u32>,
     /// Render only this rectangle: X,Y,W,H in output pixels, origin top-left.
     #[arg(long, value_name = "X,Y,W,H", value_parser = parse_region)]
@@ -154,8 +157,7 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     }
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let area = opts.area();
-    let total = u64::from(area.width) * u64::from(area.height) * u64::from(opts.quality.spp);
-    let progress = show_progress.then(|| spawn_progress(Arc::clone(&control), total));
+    let progress = show_progress.then(|| spawn_progress(Arc::clone(&control)));
 
     let result = render::render(&scene, &opts, &control);
     if let Some((done, handle)) = progress {
@@ -187,12 +189,11 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     }
     if !args.quiet {
         eprintln!(
-            "rendered {} {}x{} ({} spp, depth {}) in {:.3} s: {} rays, {:.1} Mrays/s",
+            "rendered {} {}x{} ({}) in {:.3} s: {} rays, {:.1} Mrays/s",
             scene.name,
             area.width,
             area.height,
-            opts.quality.spp,
-            opts.quality.max_depth,
+            sampling(&opts.quality, stats.rays.primary, area),
             stats.seconds,
             stats.rays.total(),
             stats.mrays_per_second()
@@ -201,10 +202,33 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A progress bar on stderr that appears only once a render has run for a second.
+/// What the closing line says of the samples and the depth: "16 spp, depth 5", or
+/// for adaptive anti-aliasing "adaptive, up to 64 spp, mean 5.8, depth 16" (`samples`:
+/// the samples traced, one primary ray each, over the `area`'s pixels).
+pub(crate) fn sampling(quality: &Quality, samples: u64, area: Region) -> String {
+    let depth = match quality.max_depth {
+        0 => "depth 0: no ray traced, every pixel is the sky".to_string(),
+        d => format!("depth {d}"),
+    };
+    match quality.adaptive {
+        Some(a) if a.first < quality.spp && quality.max_depth > 0 => {
+            let pixels = (u64::from(area.width) * u64::from(area.height)).max(1);
+            let mean = samples as f64 / pixels as f64;
+            format!(
+                "adaptive, up to {} spp, mean {mean:.1}, {depth}",
+                quality.spp
+            )
+        }
+        _ => format!("{} spp, {depth}", quality.spp),
+    }
+}
+
+/// A progress bar on stderr that appears only once a render has run for a second. It
+/// counts the samples traced against the render's total, which adaptive
+/// anti-aliasing revises as its first pass shows which pixels need more; its clock
+/// starts with the render.
 fn spawn_progress(
     control: Arc<RenderControl>,
-    total: u64,
 ) -> (
     Arc<std::sync::atomic::AtomicBool>,
     std::thread::JoinHandle<()>,
@@ -218,7 +242,8 @@ fn spawn_progress(
         while !finished.load(Ordering::Relaxed) {
             std::thread::sleep(Duration::from_millis(50));
             if bar.is_none() && start.elapsed() > Duration::from_secs(1) {
-                let b = indicatif::ProgressBar::new(total);
+                let b = indicatif::ProgressBar::new(control.samples_total())
+                    .with_elapsed(start.elapsed());
                 b.set_style(
                     indicatif::ProgressStyle::with_template(
                         "{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}",
@@ -228,6 +253,7 @@ fn spawn_progress(
                 bar = Some(b);
             }
             if let Some(b) = &bar {
+                b.set_length(control.samples_total().max(1));
                 b.set_position(control.pixels_done());
             }
         }

@@ -96,10 +96,15 @@ where
     F: Fn(usize, &mut [T], &mut RayCounts) + Sync,
 {
     let row_len = row_len.max(1);
+    // The bands in an order that spreads over the image at every moment (bit-reversed
+    // indices: 0, ½, ¼, ¾, …): the work done so far is a fair sample of the image, so a
+    // progress bar's rate and ETA hold although rows of sky cost less than rows of balls.
+    let mut bands: Vec<(usize, &mut [T])> =
+        items.chunks_mut(row_len * BAND_ROWS).enumerate().collect();
+    bands.sort_unstable_by_key(|&(band, _)| (band as u64).reverse_bits());
     in_pool(settings, || {
-        items
-            .par_chunks_mut(row_len * BAND_ROWS)
-            .enumerate()
+        bands
+            .into_par_iter()
             // Every band a task of its own. Left to itself, rayon cuts the range into a
             // few pieces and splits a piece further only when it is stolen: on two
             // threads, the half of an image whose rows cost more (balls below a sky)

@@ -64,6 +64,7 @@ pub enum RenderError {
 pub struct RenderControl {
     cancel: AtomicBool,
     pub(crate) pixels_done: AtomicU64,
+    samples_total: AtomicU64,
 }
 
 impl RenderControl {
@@ -77,9 +78,22 @@ impl RenderControl {
         self.cancel.load(Ordering::Relaxed)
     }
 
-    /// Pixel-samples finished so far (a pixel counts once per sample pass).
+    /// Samples traced so far: the work done, in the unit of
+    /// [`RenderControl::samples_total`].
     pub fn pixels_done(&self) -> u64 {
         self.pixels_done.load(Ordering::Relaxed)
+    }
+
+    /// The samples the render will trace when it is done (0 before it starts). A
+    /// render with adaptive anti-aliasing estimates its second pass from the pixels
+    /// its first pass has flagged so far, and knows it exactly once the first pass
+    /// is over; the count never includes samples that are not traced.
+    pub fn samples_total(&self) -> u64 {
+        self.samples_total.load(Ordering::Relaxed)
+    }
+
+    pub(crate) fn set_samples_total(&self, total: u64) {
+        self.samples_total.store(total, Ordering::Relaxed);
     }
 }
 
@@ -203,10 +217,11 @@ struct Traced {
 }
 
 /// Pixels of one strip of an adaptive render at most. The first pass keeps every first
-/// sample of what it covers (16 bytes a sample: half a gigabyte for a whole 3840×2160
-/// image at 4 first samples), so an image goes through it a strip at a time, which
-/// stays in a few megabytes.
-const ADAPTIVE_STRIP_PIXELS: usize = 1 << 18;
+/// sample of what it covers (64 bytes a pixel at 4 first samples: 530 MB for a whole
+/// 3840×2160 image), so a larger image goes through it a strip at a time. Up to this
+/// size an image is one strip, and its progress total is estimated from the image's
+/// own first pass; beyond it, the strips to come are estimated from the strips done.
+const ADAPTIVE_STRIP_PIXELS: usize = 1 << 21;
 
 /// Adaptive anti-aliasing of the area of `settings`, in strips of whole rows of at most
 /// `strip_pixels` pixels (at least one band of rows). A strip is rendered as a region,
@@ -222,7 +237,9 @@ fn adaptive_in_strips<T: SampleTracer>(
     let area = settings.area();
     let rows = (strip_pixels / area.width.max(1) as usize).max(BAND_ROWS) as u32;
     if rows >= area.height {
-        return adaptive(tracer, settings, a, control);
+        return adaptive(tracer, settings, a, control, &|t| {
+            control.set_samples_total(t)
+        });
     }
     let n = area.width as usize * area.height as usize;
     let mut whole = Traced {
@@ -236,8 +253,28 @@ fn adaptive_in_strips<T: SampleTracer>(
         rays: RayCounts::default(),
     };
     let bottom = area.y + area.height;
-    for y in (area.y..bottom).step_by(rows as usize) {
+    // Strips from the middle out, in bit-reversed order, so the strips done at any
+    // moment spread over the image and the progress estimate of those to come is a
+    // fair one.
+    let mut strips: Vec<u32> = (area.y..bottom).step_by(rows as usize).collect();
+    let n = strips.len() as u64;
+    strips.sort_unstable_by_key(|&y| {
+        let k = u64::from((y - area.y) / rows);
+        ((k + n / 2) % n).reverse_bits()
+    });
+    let start = control.pixels_done();
+    let mut rows_done = 0u64;
+    for y in strips {
         let height = rows.min(bottom - y);
+        // Progress: the samples of the strips done, this strip's estimate, and the
+        // rows still to come at the rate of the rows so far.
+        let done = control.pixels_done() - start;
+        let rows_after = u64::from(area.height) - rows_done - u64::from(height);
+        let set_total = |strip_total: u64| {
+            let rate = (done + strip_total) as f64 / (rows_done + u64::from(height)) as f64;
+            let rest = (rate * rows_after as f64).round() as u64;
+            control.set_samples_total(start + done + strip_total + rest);
+        };
         let strip = Settings {
             region: Some(Region {
                 x: area.x,
@@ -248,7 +285,8 @@ fn adaptive_in_strips<T: SampleTracer>(
             tile: None,
             ..settings.clone()
         };
-        let part = adaptive(tracer, &strip, a, control)?;
+        let part = adaptive(tracer, &strip, a, control, &set_total)?;
+        rows_done += u64::from(height);
         // Both frames count rows from the bottom: the strip's bottom row is the
         // area's row `bottom - (y + height)`.
         let start = (bottom - (y + height)) as usize * area.width as usize;
@@ -270,6 +308,7 @@ fn render_with<T: SampleTracer>(
     let area = settings.area();
     let spp = settings.quality.spp;
     let n = area.width as usize * area.height as usize;
+    control.set_samples_total(n as u64 * u64::from(spp));
     let frame = |pixels| Frame {
         width: area.width,
         height: area.height,
@@ -424,11 +463,15 @@ mod tests {
             (settings.width, settings.height, settings.quality.spp) = (96, 54, 16);
             settings.region = region;
             let control = RenderControl::default();
-            let whole = adaptive(&tracer, &settings, a, &control).unwrap();
+            let whole = adaptive(&tracer, &settings, a, &control, &|_| {}).unwrap();
             // Strips of one band (8 rows), of 17 rows, and one strip.
             for strip_pixels in [1, 17 * 96, usize::MAX] {
+                let control = RenderControl::default();
                 let strips =
                     adaptive_in_strips(&tracer, &settings, a, &control, strip_pixels).unwrap();
+                // The progress total ends at the samples traced, strips or not.
+                assert_eq!(control.samples_total(), control.pixels_done());
+                assert_eq!(control.pixels_done(), strips.rays.primary);
                 assert_eq!(strips.frame, whole.frame, "{region:?} {strip_pixels}");
                 assert_eq!(strips.cutoff_bound, whole.cutoff_bound);
                 assert_eq!(strips.refined, whole.refined);

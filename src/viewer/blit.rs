@@ -52,23 +52,50 @@ impl Blitter {
     /// rasterizer (llvmpipe, lavapipe: wgpu prefers any GPU to those), the reason is
     /// printed and `softbuffer` used instead. On a CPU, `pixels` draws each 1280×720
     /// frame in ~15 ms of the cores the render needs, `softbuffer` in ~1 ms.
+    /// Either way one line on stderr says which blitter draws ([`Blitter::line`]).
     pub fn new(window: &Arc<Window>, size: (u32, u32), choice: Choice) -> Result<Blitter, String> {
-        match choice {
-            Choice::Pixels => Self::pixels(window, size),
-            Choice::Softbuffer => Self::soft(window, size),
+        let (blitter, fallback) = match choice {
+            Choice::Pixels => (Self::pixels(window, size)?, None),
+            Choice::Softbuffer => (Self::soft(window, size)?, None),
             Choice::Auto => {
                 let reason = match Self::pixels(window, size) {
                     Ok(blitter) => match blitter.adapter_info() {
                         Some(info) if info.device_type == DeviceType::Cpu => {
                             format!("the graphics adapter, {}, is a CPU", info.name)
                         }
-                        _ => return Ok(blitter),
+                        _ => return Ok(blitter.announced(choice, None)),
                     },
                     Err(e) => e,
                 };
-                eprintln!("whitted: {reason}; drawing with softbuffer instead");
-                Self::soft(window, size)
+                (Self::soft(window, size)?, Some(reason))
             }
+        };
+        Ok(blitter.announced(choice, fallback.as_deref()))
+    }
+
+    /// This blitter, once [`Blitter::line`] is printed.
+    fn announced(self, choice: Choice, fallback: Option<&str>) -> Blitter {
+        eprintln!(
+            "{}",
+            Blitter::line(self.name(), self.adapter().as_deref(), choice, fallback)
+        );
+        self
+    }
+
+    /// The line that says which blitter draws: `pixels` and its adapter, or
+    /// `softbuffer`; why, when `pixels` was turned down (`fallback`); and the
+    /// variable, when `WHITTED_BLIT` chose.
+    pub fn line(
+        name: &str,
+        adapter: Option<&str>,
+        choice: Choice,
+        fallback: Option<&str>,
+    ) -> String {
+        let on = adapter.map(|a| format!(" on {a}")).unwrap_or_default();
+        match (fallback, choice) {
+            (Some(reason), _) => format!("whitted: {reason}; drawing with {name} instead"),
+            (None, Choice::Auto) => format!("whitted: drawing with {name}{on}"),
+            (None, _) => format!("whitted: drawing with {name}{on} (WHITTED_BLIT={name})"),
         }
     }
 
@@ -201,5 +228,31 @@ mod tests {
         assert_eq!(parse_choice(Some("SoftBuffer")), Ok(Choice::Softbuffer));
         let err = parse_choice(Some("gl")).unwrap_err();
         assert!(err.contains("WHITTED_BLIT=gl"), "{err}");
+    }
+
+    #[test]
+    fn one_line_says_which_blitter_draws_either_way() {
+        let gpu = Some("NVIDIA GeForce (DiscreteGpu)");
+        assert_eq!(
+            Blitter::line("pixels", gpu, Choice::Auto, None),
+            "whitted: drawing with pixels on NVIDIA GeForce (DiscreteGpu)"
+        );
+        assert_eq!(
+            Blitter::line("pixels", gpu, Choice::Pixels, None),
+            "whitted: drawing with pixels on NVIDIA GeForce (DiscreteGpu) (WHITTED_BLIT=pixels)"
+        );
+        assert_eq!(
+            Blitter::line("softbuffer", None, Choice::Softbuffer, None),
+            "whitted: drawing with softbuffer (WHITTED_BLIT=softbuffer)"
+        );
+        assert_eq!(
+            Blitter::line(
+                "softbuffer",
+                None,
+                Choice::Auto,
+                Some("the graphics adapter, llvmpipe, is a CPU")
+            ),
+            "whitted: the graphics adapter, llvmpipe, is a CPU; drawing with softbuffer instead"
+        );
     }
 }

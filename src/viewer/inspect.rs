@@ -1,6 +1,8 @@
 //! The pixel inspector: a click prints the pixel (`j` from the bottom, as in GLUT),
 //! the sphere its centre ray hits and the whole ray tree, traced again by the `f64`
-//! reference with a recorder ([`ReferenceTracer::inspect`]).
+//! reference with a recorder ([`ReferenceTracer::inspect`]). Spheres and lights are
+//! counted from 1, as a scene file's `[[sphere]]` and `[[light]]` tables are in its
+//! error messages (the tracer's records count from 0).
 
 use std::fmt::Write;
 
@@ -45,7 +47,7 @@ pub fn report(
             let _ = writeln!(
                 out,
                 "  hit sphere {} at {}, {}",
-                hit.sphere,
+                hit.sphere + 1,
                 v3(hit.point),
                 if hit.entering {
                     "from outside"
@@ -71,7 +73,7 @@ fn write_node(out: &mut String, node: &RayNode, indent: usize) {
     let pad = " ".repeat(indent);
     let target = match (node.hit, node.depth_limited) {
         (_, true) => "depth limit: sky".to_string(),
-        (Some(hit), _) => format!("sphere {}", hit.sphere),
+        (Some(hit), _) => format!("sphere {}", hit.sphere + 1),
         (None, _) => "sky".to_string(),
     };
     let _ = writeln!(
@@ -85,14 +87,14 @@ fn write_node(out: &mut String, node: &RayNode, indent: usize) {
     );
     for shadow in &node.shadows {
         let occluder = match shadow.occluder {
-            Some(k) => format!("blocked by sphere {k}"),
+            Some(k) => format!("blocked by sphere {}", k + 1),
             None => "unblocked".to_string(),
         };
         let _ = writeln!(
             out,
             "{pad}  {:<8} light {} {occluder}, factor {:.4}, weight {:.4} colour {}",
             "shadow",
-            shadow.light,
+            shadow.light + 1,
             shadow.factor,
             shadow.weight,
             v3(shadow.colour)
@@ -182,9 +184,14 @@ mod tests {
         let text = report(&scene, 64, 36, 10, 0, Vec3::new(0.5, 1.0, 0.0)).unwrap();
         assert!(text.starts_with("pixel i=10 j=0 (j from the bottom) of 64x36"));
         assert!(text.contains("[128, 255, 0]"), "{text}");
-        assert!(text.contains("hit sphere 0 at"), "{text}");
-        assert!(text.contains("primary  depth 0 sphere 0"), "{text}");
-        assert!(text.contains("shadow   light 0"), "{text}");
+        // The ground is the first [[sphere]] of the file: sphere 1, as in its errors.
+        assert!(text.contains("hit sphere 1 at"), "{text}");
+        assert!(text.contains("primary  depth 0 sphere 1 "), "{text}");
+        assert!(text.contains("shadow   light 1 "), "{text}");
+        assert!(
+            !text.contains("sphere 0") && !text.contains("light 0"),
+            "{text}"
+        );
         let sky = report(&scene, 64, 36, 10, 35, Vec3::ONE).unwrap();
         assert!(sky.contains("hit nothing: sky"), "{sky}");
     }

@@ -54,6 +54,7 @@ pub fn run(scene: Scene) -> anyhow::Result<()> {
     if !has_display {
         bail!("no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset); {hint}");
     }
+    let _runtime_dir = quiet_wayland_probe();
     let event_loop = EventLoop::<Report>::with_user_event()
         .build()
         .map_err(|e| anyhow!("cannot open the display ({}); {hint}", winit_message(&e)))?;
@@ -63,6 +64,27 @@ pub fn run(scene: Scene) -> anyhow::Result<()> {
         .run_app(&mut app)
         .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
     app.finish()
+}
+
+/// Without Wayland (no `WAYLAND_DISPLAY`) and without a valid `XDG_RUNTIME_DIR`, points
+/// `XDG_RUNTIME_DIR` at a private empty folder for the life of the window (the
+/// returned guard removes it). Mesa's Vulkan device-select layer looks for a Wayland
+/// display whenever wgpu asks for Wayland surfaces, and libwayland prints "error:
+/// XDG_RUNTIME_DIR is invalid or not set in the environment." twice when that
+/// variable is missing, although the window (on X11) works. In an empty folder the
+/// probe finds no display and says nothing. Runs before any thread is started.
+fn quiet_wayland_probe() -> Option<tempfile::TempDir> {
+    let set = |v: &str| std::env::var_os(v).filter(|s| !s.is_empty());
+    let runtime_ok = set("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_absolute());
+    if set("WAYLAND_DISPLAY").is_some() || runtime_ok {
+        return None;
+    }
+    let dir = tempfile::Builder::new()
+        .prefix("whitted-runtime-")
+        .tempdir()
+        .ok()?;
+    std::env::set_var("XDG_RUNTIME_DIR", dir.path());
+    Some(dir)
 }
 
 /// winit's error without the source location it prefixes to OS errors.

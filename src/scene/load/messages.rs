@@ -62,6 +62,15 @@ pub(super) fn from_toml<T: serde::de::DeserializeOwned>(
                 };
                 at.at(span, message)
             }
+            // A missing key: named by its table ("sphere 2: missing field `radius`"),
+            // counted from 1 as in the validation messages.
+            (Some(span), None) if message.starts_with("missing field ") => {
+                let message = match table_at(at.text, span.start.saturating_add(at.offset)) {
+                    Some(table) => format!("{table}: {message}"),
+                    None => message,
+                };
+                at.at(span, message)
+            }
             (Some(span), None) => at.at(span, message),
             (None, plain) => at.whole(plain.unwrap_or(message)),
         }
@@ -117,7 +126,37 @@ pub(super) fn field_at(text: &str, offset: usize) -> Option<String> {
     if key.is_empty() || !key.chars().all(bare) || !value.trim().is_empty() {
         return None;
     }
-    let before = &text[..line_start];
+    Some(match enclosing_table(&text[..line_start]) {
+        None => key.to_string(),
+        Some(Table::Array(name, index)) => format!("{name} {index}: {key}"),
+        Some(Table::Plain(name)) => format!("{name}.{key}"),
+    })
+}
+
+/// The table whose header is on the line of byte `offset`, named as the validation
+/// messages name tables: "sphere 2" (the second `[[sphere]]`, counted from 1),
+/// "image". `None` off a header line (an inline table, say).
+pub(super) fn table_at(text: &str, offset: usize) -> Option<String> {
+    let offset = text.floor_char_boundary_compat(offset.min(text.len()));
+    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    let line_end = text[offset..].find('\n').map_or(text.len(), |i| offset + i);
+    if !text[line_start..line_end].trim_start().starts_with('[') {
+        return None;
+    }
+    Some(match enclosing_table(&text[..line_end])? {
+        Table::Array(name, index) => format!("{name} {index}"),
+        Table::Plain(name) => name,
+    })
+}
+
+/// A table of a scene file: `[image]`, or the `index`-th `[[sphere]]` (from 1).
+enum Table {
+    Plain(String),
+    Array(String, usize),
+}
+
+/// The table of the last header in `before`.
+fn enclosing_table(before: &str) -> Option<Table> {
     // A header's table name: `[image]` → ("image", false), `[[sphere]]` → ("sphere", true).
     let header = |line: &str| -> Option<(String, bool)> {
         let line = line.trim();
@@ -125,17 +164,16 @@ pub(super) fn field_at(text: &str, offset: usize) -> Option<String> {
         let name = line.trim_start_matches('[').split(']').next()?.trim();
         line.starts_with('[').then(|| (name.to_string(), array))
     };
-    Some(match before.lines().rev().find_map(header) {
-        None => key.to_string(),
-        Some((table, true)) => {
+    Some(match before.lines().rev().find_map(header)? {
+        (table, true) => {
             let index = before
                 .lines()
                 .filter_map(header)
                 .filter(|(name, array)| *array && *name == table)
                 .count();
-            format!("{table} {index}: {key}")
+            Table::Array(table, index)
         }
-        Some((table, false)) => format!("{table}.{key}"),
+        (table, false) => Table::Plain(table),
     })
 }
 
@@ -202,6 +240,16 @@ mod tests {
             field_at(text, text.find('z').unwrap()).as_deref(),
             Some("light 1: intensity")
         );
+        // A table by its header line; not off a header.
+        let header = |needle: &str| table_at(text, text.find(needle).unwrap());
+        assert_eq!(header("[[light]]").as_deref(), Some("light 1"));
+        assert_eq!(header("z\n"), None);
+        let spheres = "[image]\n[[sphere]]\nradius = 1\n[[sphere]]\ncenter = [0, 0, 0]\n";
+        assert_eq!(
+            table_at(spheres, spheres.rfind("[[").unwrap()).as_deref(),
+            Some("sphere 2")
+        );
+        assert_eq!(table_at(spheres, 0).as_deref(), Some("image"));
         // Offsets past the end or inside a character do not panic.
         assert_eq!(field_at("é = ", 1), None);
         assert_eq!(field_at("a = ", 99).as_deref(), Some("a"));

@@ -9,7 +9,9 @@ use super::schema::{FileAnimation, FileCamera, FileScene, FileSphere, Num, V3};
 use crate::camera::CameraSpec;
 use crate::limits;
 use crate::scene::{Animation, CameraKey, Light, Motion, Scene, SceneError, Sky, Sphere};
-use crate::settings::{Encoding, Overrides, Preset, Settings, UnknownEncoding, UnknownPreset};
+use crate::settings::{
+    Encoding, Overrides, Preset, Settings, SettingsError, UnknownEncoding, UnknownPreset,
+};
 
 /// Everything but the spheres, validated.
 pub(super) fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneError> {
@@ -87,10 +89,17 @@ pub(super) fn settings(at: &Locator, file: &FileScene) -> Result<Scene, SceneErr
             }
             image.seed = Some(n as u64);
         }
-        Settings::default()
-            .with(&image)
-            .check()
-            .map_err(|e| at.at(spanned.span(), e.to_string()))?;
+        Settings::default().with(&image).check().map_err(|e| {
+            let message = match e {
+                // A scene file describes a whole image, which must fit in one render.
+                SettingsError::TooManyPixels { width, height } => format!(
+                    "image size {width}x{height} is too large: at most {} pixels",
+                    limits::MAX_PIXELS
+                ),
+                e => e.to_string(),
+            };
+            at.at(spanned.span(), message)
+        })?;
     }
 
     let mut sky = Sky::default();
