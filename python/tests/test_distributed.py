@@ -86,9 +86,9 @@ def test_linear_tiles_equal_render_linear(cluster):
     assert np.array_equal(image, whitted.render_linear(scene, width=200, height=100, spp=4))
 
 
-def test_the_default_tile_count_is_four_a_worker_thread(cluster):
+def test_the_default_tile_count_is_eight_a_worker_thread(cluster):
     _, _, client = cluster
-    assert default_tiles(client, 1280, 720) == 4 * WORKERS
+    assert default_tiles(client, 1280, 720) == 8 * WORKERS
     assert default_tiles(client, 2, 3) == 6
 
 

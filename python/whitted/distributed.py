@@ -27,8 +27,10 @@ import whitted
 
 #: Tiles per worker thread when ``tiles`` is not given: enough that a thread that drew
 #: cheap tiles (sky) takes more while another works through the costly ones, few enough
-#: that a tile's fixed cost (a task, a scene parse, the hierarchy build) stays small.
-TILES_PER_THREAD = 4
+#: that a tile's fixed cost (a task, a scene parse, the hierarchy build; about 4 ms)
+#: stays small. On 2 single-thread workers, a 3840x2160 `quality="default"` render took
+#: 1.99 s in 8 tiles, 1.72 s in 16, 1.75 s in 32 and 2.72 s in 256.
+TILES_PER_THREAD = 8
 
 
 def default_tiles(client: Any, width: int, height: int) -> int:
@@ -185,7 +187,7 @@ def main(argv: Optional[Iterable[str]] = None) -> int:
     parser.add_argument("--scheduler", required=True, help="the scheduler, e.g. tcp://host:8786")
     parser.add_argument("scene", help="a scene file (TOML), or 'hw3' for the built-in scene")
     parser.add_argument("-o", "--output", required=True, help="the image file (.png .ppm .bmp .jpg .exr)")
-    parser.add_argument("--tiles", type=int, help="tiles (default: 4 per worker thread)")
+    parser.add_argument("--tiles", type=int, help="tiles (default: 8 per worker thread)")
     parser.add_argument(
         "--frames",
         nargs="?",
