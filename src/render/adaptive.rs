@@ -285,14 +285,19 @@ mod tests {
         }
     }
 
-    #[test]
-    fn progress_counts_the_samples_traced_and_its_total_settles_early() {
+    /// Renders hw3 at 320×180 with the `high` preset on one thread (the bands in their
+    /// order, whatever else runs on the machine) through `render`, checks that every
+    /// sample traced is counted once and the total ends exact, and returns the render
+    /// and the largest gap between the share the bar shows and the true share once a
+    /// tenth of the work is done.
+    fn watch_progress(
+        render: impl FnOnce(&Watched, &Settings, Adaptive, &RenderControl) -> Traced,
+    ) -> (Traced, f64) {
         let scene = hw3_scene(HW3_DEFAULT_SEED);
         let mut settings = scene.settings().with(&crate::settings::Overrides {
             quality: Some(Preset::High),
             width: Some(320),
             height: Some(180),
-            // One thread: the bands in their order, whatever else runs on the machine.
             threads: Some(1),
             ..Default::default()
         });
@@ -306,56 +311,7 @@ mod tests {
         let Some(a) = settings.quality.adaptive else {
             panic!("high is adaptive")
         };
-        let traced = adaptive(&watched, &settings, a, &control, &|t| {
-            control.set_samples_total(t)
-        })
-        .unwrap();
-
-        // Every sample traced is counted once, and no sample that is not.
-        let seen = watched.seen.into_inner().unwrap();
-        let samples = seen.len() as u64;
-        assert_eq!(control.pixels_done(), samples);
-        assert_eq!(control.samples_total(), samples);
-        assert_eq!(traced.rays.primary, samples);
-        // Only some pixels get the rest of the samples.
-        assert!(traced.refined > 0 && traced.refined < 320 * 180 / 2);
-
-        // Once a tenth of the work is done, the share shown is within 5 points of the
-        // true share at every sample: no long stall, no jump.
-        for &(done, total) in &seen {
-            let shown = done as f64 / total.max(1) as f64;
-            let real = done as f64 / samples as f64;
-            if real > 0.1 {
-                assert!(
-                    (shown - real).abs() < 0.05,
-                    "at {done} of {samples} samples the bar shows {shown:.3}"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn progress_in_strips_settles_early_too() {
-        let scene = hw3_scene(HW3_DEFAULT_SEED);
-        let settings = scene.settings().with(&crate::settings::Overrides {
-            quality: Some(Preset::High),
-            width: Some(320),
-            height: Some(180),
-            threads: Some(1),
-            ..Default::default()
-        });
-        let control = RenderControl::default();
-        let watched = Watched {
-            inner: make_tracer(&scene, &settings).unwrap(),
-            control: &control,
-            seen: Mutex::new(Vec::new()),
-        };
-        let Some(a) = settings.quality.adaptive else {
-            panic!("high is adaptive")
-        };
-        // Strips of 23 rows: 8 of them, as a 3840x2160 image has (of 2^20 pixels).
-        let traced =
-            super::super::adaptive_in_strips(&watched, &settings, a, &control, 23 * 320).unwrap();
+        let traced = render(&watched, &settings, a, &control);
         let seen = watched.seen.into_inner().unwrap();
         let samples = seen.len() as u64;
         assert_eq!(control.pixels_done(), samples);
@@ -368,8 +324,34 @@ mod tests {
                 (done as f64 / total.max(1) as f64 - done as f64 / samples as f64).abs()
             })
             .fold(0.0, f64::max);
-        // Strips differ in cost (sky above, balls below), and those to come are
-        // estimated from those done: looser than one strip's estimate (measured: 0.25).
+        (traced, worst)
+    }
+
+    #[test]
+    fn progress_counts_the_samples_traced_and_its_total_settles_early() {
+        let (traced, worst) = watch_progress(|tracer, settings, a, control| {
+            adaptive(tracer, settings, a, control, &|t| {
+                control.set_samples_total(t)
+            })
+            .unwrap()
+        });
+        // Only some pixels get the rest of the samples.
+        assert!(traced.refined > 0 && traced.refined < 320 * 180 / 2);
+        // No long stall, no jump.
+        assert!(
+            worst < 0.05,
+            "the bar is off by {worst:.3} past a tenth of the work"
+        );
+    }
+
+    #[test]
+    fn progress_in_strips_settles_early_too() {
+        // Strips of 23 rows: 8 of them. Strips differ in cost (sky above, balls below),
+        // and those to come are estimated from those done: looser than one strip's
+        // estimate (measured: 0.25).
+        let (_, worst) = watch_progress(|tracer, settings, a, control| {
+            super::super::adaptive_in_strips(tracer, settings, a, control, 23 * 320).unwrap()
+        });
         assert!(
             worst < 0.3,
             "the bar is off by {worst:.3} past a tenth of the work"
