@@ -270,6 +270,16 @@ pub struct Region {
     pub height: u32,
 }
 
+impl Region {
+    /// Whether the region has pixels and lies inside a `width`×`height` image.
+    pub fn fits_in(&self, width: u32, height: u32) -> bool {
+        self.width > 0
+            && self.height > 0
+            && u64::from(self.x) + u64::from(self.width) <= u64::from(width)
+            && u64::from(self.y) + u64::from(self.height) <= u64::from(height)
+    }
+}
+
 /// Tile `index` (from 0) of a grid of `count` tiles over the image: a part of the image
 /// for one machine of many (SPEC §5). The grid is the program's choice
 /// ([`Tile::grid`]); a tile is a rectangle, and the tiles cover the image once.
@@ -482,11 +492,7 @@ impl Settings {
         }
         self.quality.check()?;
         if let Some(r) = self.region {
-            let fits = r.width > 0
-                && r.height > 0
-                && u64::from(r.x) + u64::from(r.width) <= u64::from(width)
-                && u64::from(r.y) + u64::from(r.height) <= u64::from(height);
-            if !fits {
+            if !r.fits_in(width, height) {
                 return Err(SettingsError::RegionOutside {
                     region: r,
                     width,

@@ -369,14 +369,7 @@ fn write_image(
             ));
         }
         return py
-            .detach(|| {
-                let mut out = Vec::new();
-                image_io::encode_rgb8(&rgb, format, &mut out).map_err(|e| image_io::SaveError {
-                    path: path.display().to_string(),
-                    message: format!("cannot encode: {e}"),
-                })?;
-                image_io::write_atomically(&path, &out)
-            })
+            .detach(|| image_io::save_rgb8(&rgb, &path, format))
             .map_err(io);
     }
     let values: PyReadonlyArray3<f32> = image.extract().map_err(|_| {
@@ -387,7 +380,10 @@ fn write_image(
         return Err(shape_error());
     }
     let (h, w) = (shape[0] as u32, shape[1] as u32);
-    let raw: Vec<f32> = values.as_array().iter().copied().collect();
+    let raw = values
+        .as_slice()
+        .map(<[f32]>::to_vec)
+        .unwrap_or_else(|_| values.as_array().iter().copied().collect());
     let top_down = image::Rgb32FImage::from_raw(w, h, raw).ok_or_else(shape_error)?;
     let frame = image_io::parts::frame_of(&top_down);
     py.detach(|| image_io::save(&frame, &path, format, encoding))

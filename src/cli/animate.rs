@@ -380,12 +380,7 @@ fn write_frames(
                 (Some(frame), Format::Exr) => {
                     image_io::save(frame, &path, format, Encoding::Linear)?
                 }
-                _ => {
-                    let mut bytes = Vec::new();
-                    image_io::encode_rgb8(&rgb, format, &mut bytes)
-                        .with_context(|| format!("{}: cannot encode", path.display()))?;
-                    image_io::write_atomically(&path, &bytes)?;
-                }
+                _ => image_io::save_rgb8(&rgb, &path, format)?,
             }
         }
         for (_, writer) in &mut animated {

@@ -86,10 +86,7 @@ pub(crate) fn compare_command(args: CompareArgs) -> anyhow::Result<()> {
     println!("{}", line(&errors));
     if let Some(path) = &args.heatmap {
         let format = Format::from_path(path, true)?;
-        let mut bytes = Vec::new();
-        image_io::encode_rgb8(&comparison.heat_map(), format, &mut bytes)
-            .with_context(|| format!("{}: cannot encode the heat map", path.display()))?;
-        image_io::write_atomically(path, &bytes)?;
+        image_io::save_rgb8(&comparison.heat_map(), path, format)?;
     }
     let over1 = errors.off_by_more_than_1 * 100.0;
     if let Some(limit) = args.max_rmse.filter(|&l| errors.rmse > l) {

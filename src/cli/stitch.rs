@@ -50,9 +50,7 @@ pub(crate) fn stitch_command(args: StitchArgs) -> anyhow::Result<()> {
                     args.output.display()
                 );
             }
-            let mut bytes = Vec::new();
-            image_io::encode_rgb8(&image, format, &mut bytes)?;
-            image_io::write_atomically(&args.output, &bytes)?;
+            image_io::save_rgb8(&image, &args.output, format)?;
         }
     }
     Ok(())

@@ -331,6 +331,16 @@ pub fn encode(frame: &Frame, format: Format, encoding: Encoding) -> Result<Vec<u
     Ok(out)
 }
 
+/// Saves 8-bit RGB (top row first) to `path` in `format` (not EXR), atomically.
+pub fn save_rgb8(image: &RgbImage, path: &Path, format: Format) -> Result<(), SaveError> {
+    let mut bytes = Vec::new();
+    encode_rgb8(image, format, &mut bytes).map_err(|e| SaveError {
+        path: path.display().to_string(),
+        message: format!("cannot encode: {e}"),
+    })?;
+    write_atomically(path, &bytes)
+}
+
 /// Saves the frame to `path` in `format`, its bytes in `encoding`, atomically.
 pub fn save(
     frame: &Frame,

@@ -102,12 +102,7 @@ impl Placement {
             image: id?,
             encoding,
         };
-        let r = placement.region;
-        let fits = r.width > 0
-            && r.height > 0
-            && u64::from(r.x) + u64::from(r.width) <= u64::from(width)
-            && u64::from(r.y) + u64::from(r.height) <= u64::from(height);
-        fits.then_some(placement)
+        placement.region.fits_in(width, height).then_some(placement)
     }
 }
 
@@ -384,27 +379,32 @@ pub fn stitch(parts: &[(String, Part)]) -> Result<PartPixels, StitchError> {
         });
     }
     Ok(match &first.pixels {
-        PartPixels::Bytes(_) => {
-            let mut whole = RgbImage::new(w, h);
-            for (_, part) in parts {
-                if let PartPixels::Bytes(img) = &part.pixels {
-                    let r = part.placement.region;
-                    image::imageops::replace(&mut whole, img, i64::from(r.x), i64::from(r.y));
-                }
-            }
-            PartPixels::Bytes(whole)
-        }
-        PartPixels::Linear(_) => {
-            let mut whole = Rgb32FImage::new(w, h);
-            for (_, part) in parts {
-                if let PartPixels::Linear(img) = &part.pixels {
-                    let r = part.placement.region;
-                    image::imageops::replace(&mut whole, img, i64::from(r.x), i64::from(r.y));
-                }
-            }
-            PartPixels::Linear(whole)
-        }
+        PartPixels::Bytes(_) => PartPixels::Bytes(paste(parts, w, h, |p| match p {
+            PartPixels::Bytes(image) => Some(image),
+            PartPixels::Linear(_) => None,
+        })),
+        PartPixels::Linear(_) => PartPixels::Linear(paste(parts, w, h, |p| match p {
+            PartPixels::Linear(image) => Some(image),
+            PartPixels::Bytes(_) => None,
+        })),
     })
+}
+
+/// The `w`×`h` image with each part's pixels (of the kind `pixels` picks) in its place.
+fn paste<P: image::Pixel>(
+    parts: &[(String, Part)],
+    w: u32,
+    h: u32,
+    pixels: impl Fn(&PartPixels) -> Option<&image::ImageBuffer<P, Vec<P::Subpixel>>>,
+) -> image::ImageBuffer<P, Vec<P::Subpixel>> {
+    let mut whole = image::ImageBuffer::new(w, h);
+    for (_, part) in parts {
+        if let Some(img) = pixels(&part.pixels) {
+            let r = part.placement.region;
+            image::imageops::replace(&mut whole, img, i64::from(r.x), i64::from(r.y));
+        }
+    }
+    whole
 }
 
 /// A frame (rows from the bottom) from linear pixels stored top row first.
