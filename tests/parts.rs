@@ -200,6 +200,36 @@ fn gaps_overlaps_and_foreign_parts_are_refused_and_nothing_is_written() {
 }
 
 #[test]
+fn tiles_of_an_animation_frame_stitch_into_that_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let spin = ["--frames", "4", "--orbit", "90", "--frame", "2"];
+    let whole = path(d, "whole-%d.png");
+    let mut args = vec!["render", "--quiet", "-o", &whole];
+    args.extend(SIZE);
+    args.extend(spin);
+    ok(&args);
+    let mut parts = Vec::new();
+    for i in 0..4 {
+        let pattern = path(d, &format!("tile{i}-%d.png"));
+        let tile = format!("{i}/4");
+        let mut args = vec!["render", "--quiet", "--tile", &tile, "-o", &pattern];
+        args.extend(SIZE);
+        args.extend(spin);
+        ok(&args);
+        parts.push(path(d, &format!("tile{i}-2.png")));
+    }
+    let out = path(d, "out.png");
+    let run = stitch(&out, &parts);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    same_bytes(&out, &path(d, "whole-2.png"));
+}
+
+#[test]
 fn bad_tiles_are_usage_errors() {
     fails(&["render", "--tile", "4/4", "-o", "x.png"], 2, "0 <= I < N");
     fails(&["render", "--tile", "a/b", "-o", "x.png"], 2, "I/N");

@@ -22,6 +22,7 @@ use clap::Args;
 use image::RgbImage;
 
 use super::usage;
+use whitted::image_io::parts::{self, Placement};
 use whitted::image_io::{self, AnimatedFormat, AnimatedWriter, Format};
 use whitted::limits::MAX_FRAMES;
 use whitted::render::{Frame, RenderControl, RenderError, Sequence};
@@ -167,8 +168,11 @@ pub(crate) fn wanted(options: &FrameOptions, scene: &Scene, outputs: &[PathBuf])
 struct Finished {
     k: u32,
     rgb: RgbImage,
-    /// The linear values, when an EXR output needs them.
+    /// The linear values, when an EXR output or a part needs them.
     linear: Option<Frame>,
+    /// Where the frame belongs in the whole image, when it is a region or tile of it
+    /// (PNG and EXR files record it, for `whitted stitch`).
+    part: Option<(Placement, Encoding)>,
 }
 
 /// Renders the frames `options` select of `scene` (with its animation overridden by
@@ -243,15 +247,17 @@ pub(crate) fn render_frames(
         if let Output::Animated(path, format) = output {
             let writer =
                 AnimatedWriter::create(path, *format, (area.width, area.height), count, fps)?;
-            animated.push((path.clone(), writer));
+            animated.push(writer);
         }
     }
-    let linear = targets.iter().any(|o| {
-        matches!(
-            o,
-            Output::Still(_, Format::Exr) | Output::Numbered(_, Format::Exr)
-        )
-    });
+    let is_part = settings.region.is_some() || settings.tile.is_some();
+    let linear = is_part
+        || targets.iter().any(|o| {
+            matches!(
+                o,
+                Output::Still(_, Format::Exr) | Output::Numbered(_, Format::Exr)
+            )
+        });
 
     let control = Arc::new(RenderControl::default());
     {
@@ -294,10 +300,15 @@ pub(crate) fn render_frames(
         };
         rays += stats.rays.total();
         samples += stats.rays.primary;
+        let part = is_part.then(|| {
+            let still = scene.frame(k, settings.width, settings.height);
+            (Placement::of(&still, settings), settings.encoding)
+        });
         let finished = Finished {
             k,
             rgb: image_io::to_rgb8(&frame, settings.encoding),
             linear: linear.then_some(frame),
+            part,
         };
         if frames_out.send(finished).is_err() {
             break; // the writer failed: it says why
@@ -364,26 +375,35 @@ pub(crate) fn render_frames(
 fn write_frames(
     frames: Receiver<Finished>,
     targets: Vec<Output>,
-    mut animated: Vec<(PathBuf, AnimatedWriter)>,
+    mut animated: Vec<AnimatedWriter>,
     count: u32,
     done: &AtomicU64,
 ) -> anyhow::Result<u32> {
     let mut written = 0;
-    for Finished { k, rgb, linear } in frames {
+    for Finished {
+        k,
+        rgb,
+        linear,
+        part,
+    } in frames
+    {
         for target in &targets {
             let (path, format) = match target {
                 Output::Still(path, format) => (path.clone(), *format),
                 Output::Numbered(pattern, format) => (pattern.path(k), *format),
                 Output::Animated(..) => continue,
             };
-            match (&linear, format) {
-                (Some(frame), Format::Exr) => {
+            match (&linear, format, part) {
+                (Some(frame), Format::Png | Format::Exr, Some((placement, encoding))) => {
+                    parts::save_part(frame, &placement, &path, format, encoding)?
+                }
+                (Some(frame), Format::Exr, _) => {
                     image_io::save(frame, &path, format, Encoding::Linear)?
                 }
                 _ => image_io::save_rgb8(&rgb, &path, format)?,
             }
         }
-        for (_, writer) in &mut animated {
+        for writer in &mut animated {
             writer.add(&rgb)?;
         }
         written += 1;
@@ -392,7 +412,7 @@ fn write_frames(
     if written < count {
         return Ok(written); // interrupted: the animated files are dropped unwritten
     }
-    for (_, writer) in animated {
+    for writer in animated {
         writer.finish()?;
     }
     Ok(written)
