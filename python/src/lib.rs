@@ -65,7 +65,7 @@ impl PyScene {
     /// Frames a second of the scene's animation (24 without an `[animation]` table).
     #[getter]
     fn fps(&self) -> f64 {
-        self.inner.animation.as_ref().map_or(24.0, |a| a.fps)
+        self.inner.fps()
     }
 
     /// How many point lights the scene holds.

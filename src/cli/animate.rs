@@ -26,7 +26,7 @@ use whitted::image_io::parts::{self, Placement};
 use whitted::image_io::{self, AnimatedFormat, AnimatedWriter, Format};
 use whitted::limits::MAX_FRAMES;
 use whitted::render::{Frame, RenderControl, RenderError, Sequence};
-use whitted::scene::{Animation, Scene};
+use whitted::scene::Scene;
 use whitted::settings::{Encoding, Settings};
 
 /// The animation options of `whitted render`.
@@ -190,10 +190,7 @@ pub(crate) fn render_frames(
         scene.animation = Some(animation.with(options.frames, options.orbit));
     }
     let frames = scene.frames();
-    let fps = scene
-        .animation
-        .as_ref()
-        .map_or(Animation::DEFAULT_FPS, |a| a.fps);
+    let fps = scene.fps();
     let range = options.frame.unwrap_or(FrameRange {
         start: 0,
         end: frames,

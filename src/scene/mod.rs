@@ -125,6 +125,14 @@ impl Scene {
         self.animation.as_ref().map_or(1, |a| a.frames)
     }
 
+    /// Frames a second of the scene's animation ([`Animation::DEFAULT_FPS`] for a
+    /// still scene).
+    pub fn fps(&self) -> f64 {
+        self.animation
+            .as_ref()
+            .map_or(Animation::DEFAULT_FPS, |a| a.fps)
+    }
+
     /// The camera spec of frame `k` at `width`×`height`: [`Scene::camera_spec`] moved
     /// by the animation ([`Animation::camera_at`]). Every renderer of a frame (the
     /// command line, the viewer, Python) takes its camera from here.

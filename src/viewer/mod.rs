@@ -466,6 +466,9 @@ impl ApplicationHandler<Report> for App {
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         match self.next_frame_at {
             Some(due) if Instant::now() >= due => {
+                // Due once: a minimised window submits nothing, so the frame must
+                // not advance again on the next event.
+                self.next_frame_at = None;
                 self.go_to_frame(i64::from(self.frame) + 1);
                 event_loop.set_control_flow(ControlFlow::Wait);
             }

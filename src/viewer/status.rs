@@ -19,15 +19,10 @@ pub enum Progress {
     Failed,
 }
 
-/// The window title: `whitted - SCENE - WxH - PROGRESS`. It ends in `- done` exactly
-/// when every sample of the current view is on screen (the tests wait for that).
-pub fn title(scene: &str, width: u32, height: u32, progress: &Progress) -> String {
-    title_of_frame(scene, width, height, None, progress)
-}
-
-/// The title of frame `k` of `n` of an animation (`None`: a still scene):
-/// `whitted - SCENE - WxH - frame K/N - PROGRESS`, `K` counted from 0 as in the
-/// numbered files of `whitted render`.
+/// The window title: `whitted - SCENE - WxH - PROGRESS`, and for frame `k` of `n` of an
+/// animation `whitted - SCENE - WxH - frame K/N - PROGRESS`, `K` counted from 0 as in
+/// the numbered files of `whitted render`. It ends in `- done` exactly when every
+/// sample of the current view is on screen (the tests wait for that).
 pub fn title_of_frame(
     scene: &str,
     width: u32,
@@ -79,6 +74,11 @@ pub fn stats_enabled(value: Option<&str>) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The title of a still scene.
+    fn title(scene: &str, width: u32, height: u32, progress: &Progress) -> String {
+        title_of_frame(scene, width, height, None, progress)
+    }
 
     #[test]
     fn the_title_says_done_only_when_complete() {
