@@ -91,6 +91,15 @@ pub(super) fn adaptive<T: SampleTracer>(
     // Refine unless everything is surely below the threshold (so threshold 0, or a NaN
     // anywhere, refines).
     let reaches = |x: f32| x.partial_cmp(&a.threshold) != Some(std::cmp::Ordering::Less);
+    // Whether pixel `o` of an outer row is refined: its own samples or its neighbours
+    // in the row flag it (`local`), or its mean differs from the pixel below or above.
+    type Row = (Vec<Vec3>, Vec<bool>);
+    let flagged = |(means, local): &Row, below: Option<&Row>, above: Option<&Row>, o: usize| {
+        let differs = |other: Option<&Row>| {
+            other.is_some_and(|(m, _)| reaches((m[o] - means[o]).abs().max_element()))
+        };
+        local[o] || differs(below) || differs(above)
+    };
 
     // Progress counts the samples traced. The second pass traces `rest` samples in
     // each pixel the first pass flags. Until the first pass is over, that share is
@@ -105,12 +114,12 @@ pub(super) fn adaptive<T: SampleTracer>(
     let j_outer = h - (outer.y + outer.height);
     // Per outer row (from the bottom): the pixels' means and whether their own samples
     // or their neighbours in the row flag them; and whether the row was counted.
-    let rows: Vec<OnceLock<(Vec<Vec3>, Vec<bool>)>> = (0..oh).map(|_| OnceLock::new()).collect();
+    let rows: Vec<OnceLock<Row>> = (0..oh).map(|_| OnceLock::new()).collect();
     let counted: Vec<AtomicBool> = (0..oh).map(|_| AtomicBool::new(false)).collect();
     let (rows_seen, rows_flagged) = (AtomicU64::new(0), AtomicU64::new(0));
     let count_row = |r: usize| {
         let get = |q: usize| rows.get(q).and_then(OnceLock::get);
-        let Some((means, local)) = get(r) else { return };
+        let Some(row) = get(r) else { return };
         let below = if r > 0 {
             get(r - 1).map(Some)
         } else {
@@ -125,12 +134,7 @@ pub(super) fn adaptive<T: SampleTracer>(
         if counted[r].swap(true, Ordering::Relaxed) {
             return;
         }
-        let differs = |o: usize, other: Option<&(Vec<Vec3>, Vec<bool>)>| {
-            other.is_some_and(|(m, _)| reaches((m[o] - means[o]).abs().max_element()))
-        };
-        let flagged = (0..ow)
-            .filter(|&o| local[o] || differs(o, below) || differs(o, above))
-            .count() as u64;
+        let flagged = (0..ow).filter(|&o| flagged(row, below, above, o)).count() as u64;
         let seen = rows_seen.fetch_add(ow as u64, Ordering::Relaxed) + ow as u64;
         let flagged = rows_flagged.fetch_add(flagged, Ordering::Relaxed) + flagged;
         let refined = (area_pixels as f64 * flagged as f64 / seen as f64).round() as u64;
@@ -172,9 +176,11 @@ pub(super) fn adaptive<T: SampleTracer>(
             }
         },
     )?;
-    drop(rows);
+    let rows: Vec<Row> = rows
+        .into_iter()
+        .map(|r| r.into_inner().expect("the first pass did every row"))
+        .collect();
 
-    let means: Vec<Vec3> = firsts.chunks(nf).map(mean).collect();
     // Outer-grid coordinates, row 0 at the bottom: the area starts at (dx, dy).
     let dx = (area.x - x0) as usize;
     let dy = (y1 - (area.y + area.height)) as usize;
@@ -182,14 +188,8 @@ pub(super) fn adaptive<T: SampleTracer>(
     for (n, flag) in refine.iter_mut().enumerate() {
         let (ax, ay) = (n % area.width as usize, n / area.width as usize);
         let (ox, oy) = (ax + dx, ay + dy);
-        let o = oy * ow + ox;
-        let m = means[o];
-        let differs = |q: usize| reaches((means[q] - m).abs().max_element());
-        *flag = reaches(spread(&firsts[o * nf..(o + 1) * nf]))
-            || (ox > 0 && differs(o - 1))
-            || (ox + 1 < ow && differs(o + 1))
-            || (oy > 0 && differs(o - ow))
-            || (oy + 1 < oh && differs(o + ow));
+        let below = oy.checked_sub(1).map(|q| &rows[q]);
+        *flag = flagged(&rows[oy], below, rows.get(oy + 1), ox);
     }
 
     // Second pass: value and bound of each pixel of the area; progress counts the
