@@ -26,15 +26,6 @@ fn assert_fails_with(out: &Output, needles: &[&str]) {
     }
 }
 
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
-
 /// Writes `text` as `name` in a fresh folder and renders it into that folder.
 fn render_scene(name: &str, text: &str) -> (tempfile::TempDir, Output) {
     let dir = tempfile::tempdir().unwrap();
@@ -62,7 +53,11 @@ fn bad_scene_files_exit_1_naming_the_place() {
         "[[sphere]]\ncenter = [0, 0, -1]\nradius = 0.5\nshine = 3\n",
     );
     assert_fails_with(&out, &["unknown.toml:4:1", "shine"]);
-    assert_eq!(entries(dir.path()), ["unknown.toml"], "no image written");
+    assert_eq!(
+        common::entries(dir.path()),
+        ["unknown.toml"],
+        "no image written"
+    );
 
     // A wrong type: the value's line and column, the field, in the file's words.
     let (_, out) = render_scene(
@@ -132,7 +127,7 @@ fn a_missing_scene_file_exits_1_naming_it() {
         png.to_str().unwrap(),
     ]);
     assert_fails_with(&out, &["nowhere.toml"]);
-    assert!(entries(dir.path()).is_empty());
+    assert!(common::entries(dir.path()).is_empty());
 }
 
 #[test]
@@ -263,7 +258,7 @@ fn option_values_that_do_not_fit_exit_2_saying_what_would() {
         "tile 8/9 does not exist in a 2x2 image: expected an index from 0 to 8 and at most \
          as many tiles as pixels",
     );
-    assert!(entries(dir.path()).is_empty());
+    assert!(common::entries(dir.path()).is_empty());
 }
 
 /// Only the region is allocated: a 64x64 corner of a 65536x65536 image renders (within
@@ -348,7 +343,7 @@ fn a_region_outside_the_image_exits_2() {
     ]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("50x50 image"), "{}", stderr(&out));
-    assert!(entries(dir.path()).is_empty());
+    assert!(common::entries(dir.path()).is_empty());
 }
 
 #[test]
@@ -369,7 +364,11 @@ fn output_into_a_missing_folder_exits_1_and_writes_nothing() {
     ]);
     assert_fails_with(&out, &["missing"]);
     // Checked before rendering: not even the writable target was written.
-    assert!(entries(dir.path()).is_empty(), "{:?}", entries(dir.path()));
+    assert!(
+        common::entries(dir.path()).is_empty(),
+        "{:?}",
+        common::entries(dir.path())
+    );
 }
 
 #[test]
@@ -405,9 +404,11 @@ fn output_into_a_read_only_folder_exits_1_and_leaves_nothing() {
             .map(|o| !o.status.success())
             .unwrap_or(false);
         if !denied {
-            eprintln!(
-                "SKIPPED: output_into_a_read_only_folder: running as root and `setpriv` \
-                 cannot drop CAP_DAC_OVERRIDE here, so no folder is read-only"
+            common::skip(
+                "output_into_a_read_only_folder",
+                "running as root and `setpriv` cannot drop CAP_DAC_OVERRIDE here, so no \
+                 folder is read-only",
+                "a read-only folder",
             );
             return;
         }
@@ -418,7 +419,7 @@ fn output_into_a_read_only_folder_exits_1_and_leaves_nothing() {
             .output()
             .unwrap()
     };
-    let listing = entries(&ro);
+    let listing = common::entries(&ro);
     std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
     assert_fails_with(&out, &["ro", "ermission denied"]);
     assert!(listing.is_empty(), "left behind: {listing:?}");
@@ -448,7 +449,7 @@ fn a_good_render_exits_0_with_a_closing_line() {
         "closing line: {last}"
     );
     assert!(err.contains("wrote "), "{err}");
-    assert_eq!(entries(dir.path()), ["out.png"]);
+    assert_eq!(common::entries(dir.path()), ["out.png"]);
 
     // --quiet: nothing on stderr (and no progress bar when stderr is not a terminal).
     let out = whitted(&[
@@ -468,7 +469,11 @@ fn a_good_render_exits_0_with_a_closing_line() {
 #[test]
 fn scene_printing_fails_cleanly_when_stdout_cannot_be_written() {
     let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
-        eprintln!("SKIPPED: scene_printing_fails_cleanly: no /dev/full on this system");
+        common::skip(
+            "scene_printing_fails_cleanly",
+            "no /dev/full on this system",
+            "a full standard output",
+        );
         return;
     };
     let out = Command::new(env!("CARGO_BIN_EXE_whitted"))

@@ -203,13 +203,6 @@ fn default_outputs_are_output_ppm_and_output_png() {
     assert_upright(&png, 0, "output.png");
 }
 
-fn entries(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect()
-}
-
 #[test]
 fn a_failed_save_leaves_nothing_behind() {
     let frame = library_frame();
@@ -219,14 +212,14 @@ fn a_failed_save_leaves_nothing_behind() {
     std::fs::create_dir(&target).unwrap();
     let err = image_io::save(&frame, &target, Format::Png, Encoding::Linear).unwrap_err();
     assert!(err.to_string().contains("taken.png"), "{err}");
-    assert_eq!(entries(dir.path()), ["taken.png"]);
-    assert!(entries(&target).is_empty());
+    assert_eq!(common::entries(dir.path()), ["taken.png"]);
+    assert!(common::entries(&target).is_empty());
 
     // A missing folder: an error naming the path, nothing created.
     let missing = dir.path().join("no/such/folder/a.png");
     let err = image_io::save(&frame, &missing, Format::Png, Encoding::Linear).unwrap_err();
     assert!(err.to_string().contains("no/such/folder"), "{err}");
-    assert_eq!(entries(dir.path()), ["taken.png"]);
+    assert_eq!(common::entries(dir.path()), ["taken.png"]);
 
     // A successful save replaces an existing file whole.
     let file = dir.path().join("a.ppm");
@@ -239,7 +232,7 @@ fn a_failed_save_leaves_nothing_behind() {
     )
     .unwrap();
     assert!(image::open(&file).unwrap().into_rgb8() == image_io::to_rgb8(&frame, Encoding::Linear));
-    let mut names = entries(dir.path());
+    let mut names = common::entries(dir.path());
     names.sort();
     assert_eq!(names, ["a.ppm", "taken.png"]);
 }
@@ -349,7 +342,7 @@ fn a_symbolic_link_keeps_pointing_at_the_new_image() {
         .is_symlink());
     assert_eq!(std::fs::read_link(&link).unwrap(), real);
     assert!(image::open(&real).unwrap().into_rgb8() == image_io::to_rgb8(&frame, Encoding::Linear));
-    assert_eq!(entries(&images), ["real.png"]);
+    assert_eq!(common::entries(&images), ["real.png"]);
 }
 
 #[test]
@@ -361,7 +354,11 @@ fn a_fifo_receives_the_image_in_place() {
         .status()
         .is_ok_and(|s| s.success());
     if !made {
-        eprintln!("SKIPPED: a_fifo_receives_the_image_in_place: mkfifo failed here");
+        common::skip(
+            "a_fifo_receives_the_image_in_place",
+            "mkfifo failed here",
+            "writing into a FIFO",
+        );
         return;
     }
     // A reader on the other end, as in `whitted render -o pipe.ppm & viewer pipe.ppm`.
@@ -390,7 +387,7 @@ fn a_fifo_receives_the_image_in_place() {
             .is_fifo(),
         "the FIFO was replaced by a file"
     );
-    assert_eq!(entries(dir.path()), ["pipe.ppm"]);
+    assert_eq!(common::entries(dir.path()), ["pipe.ppm"]);
     let bytes = reader.join().unwrap();
     let decoded = image::load_from_memory(&bytes).unwrap().into_rgb8();
     assert!(decoded == image_io::to_rgb8(&library_frame(), Encoding::Linear));

@@ -6,22 +6,14 @@
 //! left alone (`image_io::write_atomically`).
 #![cfg(all(feature = "cli", feature = "viewer"))]
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 fn whitted() -> Command {
     Command::new(env!("CARGO_BIN_EXE_whitted"))
-}
-
-/// Files left in `dir`.
-fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 /// Runs `script` in `sh` inside new user and mount namespaces (so it may mount a tmpfs
@@ -60,14 +52,22 @@ fn a_full_disk_or_a_read_only_folder_leaves_no_file() {
              echo \"rc=$?\"; ls -A '{mnt}'"
         );
         let Some(out) = in_mount_namespace(&script) else {
-            eprintln!("SKIPPED ({what}): cannot create user/mount namespaces (unshare -rm) here");
+            common::skip(
+                what,
+                "cannot create user/mount namespaces (unshare -rm) here",
+                "a full or read-only file system",
+            );
             continue;
         };
         let stdout = String::from_utf8_lossy(&out.stdout);
         let stderr = String::from_utf8_lossy(&out.stderr);
         println!("{what}: stdout {stdout:?} stderr {stderr:?}");
         if out.status.code() == Some(99) {
-            eprintln!("SKIPPED ({what}): cannot mount a tmpfs in a namespace: {stderr}");
+            common::skip(
+                what,
+                &format!("cannot mount a tmpfs in a namespace: {stderr}"),
+                "a full or read-only file system",
+            );
             continue;
         }
         let mut lines = stdout.lines();
@@ -94,7 +94,11 @@ fn a_full_disk_or_a_read_only_folder_leaves_no_file() {
     println!("file-size limit: {:?} {stderr:?}", out.status.code());
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+    assert!(
+        common::entries(dir.path()).is_empty(),
+        "{:?}",
+        common::entries(dir.path())
+    );
 }
 
 /// `-o /dev/full`: a path with no image extension is a usage error (exit 2) found
@@ -103,7 +107,7 @@ fn a_full_disk_or_a_read_only_folder_leaves_no_file() {
 /// device node with an image name is in `writing_to_a_full_device_fails_and_leaves_it_alone`.
 #[test]
 fn writing_to_dev_full_fails_cleanly() {
-    let before = listing(Path::new("/dev"));
+    let before = common::entries(Path::new("/dev"));
     for (target, code) in [("/dev/full", 2), ("/dev/full/out.png", 1)] {
         let out = whitted()
             .args([
@@ -117,7 +121,11 @@ fn writing_to_dev_full_fails_cleanly() {
         assert_eq!(stderr.lines().count(), 1, "{stderr}");
         assert!(stderr.contains("/dev/full"), "{stderr}");
     }
-    assert_eq!(listing(Path::new("/dev")), before, "nothing left in /dev");
+    assert_eq!(
+        common::entries(Path::new("/dev")),
+        before,
+        "nothing left in /dev"
+    );
 }
 
 /// SIGINT during a long render (the f64 reference, 64 spp at 1280x720): exit 1 with one
@@ -165,7 +173,11 @@ fn an_interrupted_render_leaves_no_file() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(stderr.contains("interrupted"), "{stderr}");
-    assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+    assert!(
+        common::entries(dir.path()).is_empty(),
+        "{:?}",
+        common::entries(dir.path())
+    );
 }
 
 /// A render written to a device node that behaves like `/dev/full` (char 1,7,
@@ -184,7 +196,11 @@ fn writing_to_a_full_device_fails_and_leaves_it_alone() {
         .status()
         .is_ok_and(|s| s.success());
     if !made {
-        eprintln!("SKIPPED: cannot make a device node here (mknod needs CAP_MKNOD)");
+        common::skip(
+            "a full device node",
+            "cannot make a device node here (mknod needs CAP_MKNOD)",
+            "writing into a device",
+        );
         return;
     }
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_whitted"))

@@ -8,6 +8,8 @@
 //! `CI=true` (CI always has them: see `.ci/run`) a missing tool fails the test.
 #![cfg(all(feature = "cli", feature = "viewer"))]
 
+mod common;
+
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -34,18 +36,11 @@ fn x_tools_or_skip(test: &str) -> bool {
     if missing.is_empty() {
         return true;
     }
-    let what = format!(
-        "{test}: {} not installed (apt-get install xvfb xdotool imagemagick)",
+    let why = format!(
+        "{} not installed (apt-get install xvfb xdotool imagemagick)",
         missing.join(", ")
     );
-    if std::env::var("CI").is_ok_and(|v| v == "true") {
-        panic!("{what}; CI=true, so the viewer must be tested");
-    }
-    use std::io::Write;
-    let _ = writeln!(
-        std::io::stderr(),
-        "SKIPPED {what}: the viewer was NOT tested"
-    );
+    common::skip(test, &why, "the viewer");
     false
 }
 

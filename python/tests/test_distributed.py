@@ -10,6 +10,7 @@ import subprocess
 import sys
 import time
 
+import distributed
 import numpy as np
 import pytest
 
@@ -17,8 +18,6 @@ import whitted
 from whitted.distributed import default_tiles, render_tiles
 
 from conftest import read_ppm
-
-distributed = pytest.importorskip("distributed")
 
 WORKERS = 3
 
