@@ -3,22 +3,14 @@
 //! turntable against still scenes turned by hand, and the files of `whitted render`:
 //! numbered frames, GIF and APNG decoded frame by frame, slices of a sequence equal
 //! to the same frames of the whole run.
-#![cfg(all(feature = "cli", feature = "viewer"))]
-
-use std::io::BufReader;
-use std::path::Path;
-use std::process::{Command, Output};
 
 use glam::DVec3;
-use image::{AnimationDecoder, RgbImage};
 use whitted::camera::CameraSpec;
 use whitted::image_io;
 use whitted::render::{self, RenderControl, Sequence};
 use whitted::scene::{hw3_scene, to_toml, Animation, CameraKey, Motion, HW3_DEFAULT_SEED};
 use whitted::settings::Encoding;
 use whitted::{Overrides, Scene};
-
-const BIN: &str = env!("CARGO_BIN_EXE_whitted");
 
 fn parse(text: &str) -> Scene {
     Scene::from_toml_str(text, "anim.toml").unwrap_or_else(|e| panic!("{e}"))
@@ -345,248 +337,262 @@ fn a_sequence_renders_each_frame_as_its_still_scene_does() {
 
 // ---- Files -----------------------------------------------------------------------
 
-fn run(args: &[&str], dir: &Path) -> Output {
-    let out = Command::new(BIN)
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run whitted");
-    assert!(
-        out.status.success(),
-        "whitted {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
+/// What goes through the `whitted` binary, which needs the `cli` and `viewer` features.
+#[cfg(all(feature = "cli", feature = "viewer"))]
+mod command_line {
+    use std::io::BufReader;
+    use std::path::Path;
+    use std::process::{Command, Output};
 
-/// A 6-frame turntable of hw3 at 96×54 and 10 fps, written as `spin.toml` in `dir`.
-fn spin_file(dir: &Path) -> String {
-    let mut scene = turntable(6, 300.0);
-    scene.animation.as_mut().unwrap().fps = 10.0;
-    scene.image.width = Some(96);
-    scene.image.height = Some(54);
-    let path = dir.join("spin.toml");
-    std::fs::write(&path, to_toml(&scene)).unwrap();
-    path.to_str().unwrap().to_string()
-}
+    use image::{AnimationDecoder, RgbImage};
 
-fn png(path: &Path) -> RgbImage {
-    image::open(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_rgb8()
-}
+    use super::*;
 
-fn rgb(frame: image::Frame) -> RgbImage {
-    image::DynamicImage::ImageRgba8(frame.into_buffer()).to_rgb8()
-}
+    const BIN: &str = env!("CARGO_BIN_EXE_whitted");
 
-#[test]
-fn gif_and_apng_hold_the_numbered_frames() {
-    let dir = tempfile::tempdir().unwrap();
-    let dir = dir.path();
-    let scene = spin_file(dir);
-    run(
-        &[
-            "render",
-            &scene,
-            "-q",
-            "-o",
-            "f-%03d.png",
-            "-o",
-            "spin.gif",
-            "-o",
-            "spin.apng",
-        ],
-        dir,
-    );
-    let numbered: Vec<RgbImage> = (0..6)
-        .map(|k| png(&dir.join(format!("f-{k:03}.png"))))
-        .collect();
-    assert!(
-        numbered.windows(2).all(|w| w[0] != w[1]),
-        "the frames differ"
-    );
-
-    // APNG: lossless, 6 frames of 1/10 s.
-    let file = BufReader::new(std::fs::File::open(dir.join("spin.apng")).unwrap());
-    let decoder = image::codecs::png::PngDecoder::new(file).unwrap();
-    assert!(decoder.is_apng().unwrap());
-    let frames = decoder
-        .apng()
-        .unwrap()
-        .into_frames()
-        .collect_frames()
-        .unwrap();
-    assert_eq!(frames.len(), 6);
-    for (k, frame) in frames.into_iter().enumerate() {
-        assert_eq!(frame.delay().numer_denom_ms(), (100, 1), "frame {k}");
-        assert!(
-            rgb(frame) == numbered[k],
-            "APNG frame {k} differs from f-{k:03}.png"
-        );
-    }
-
-    // GIF: 6 frames of 10/100 s, each within its palette's error of the PNG.
-    let file = BufReader::new(std::fs::File::open(dir.join("spin.gif")).unwrap());
-    let frames = image::codecs::gif::GifDecoder::new(file)
-        .unwrap()
-        .into_frames()
-        .collect_frames()
-        .unwrap();
-    assert_eq!(frames.len(), 6);
-    let mut errors: Vec<u8> = Vec::new();
-    for (k, frame) in frames.into_iter().enumerate() {
-        assert_eq!(frame.delay().numer_denom_ms(), (100, 1), "frame {k}");
-        let decoded = rgb(frame);
-        assert_eq!(decoded.dimensions(), (96, 54));
-        let pixels = decoded.pixels().zip(numbered[k].pixels());
-        errors.extend(pixels.map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap()));
-    }
-    errors.sort_unstable();
-    let mean = errors.iter().map(|&d| f64::from(d)).sum::<f64>() / errors.len() as f64;
-    let p99 = errors[errors.len() * 99 / 100];
-    let worst = errors[errors.len() - 1];
-    println!("GIF palette error per pixel: mean {mean:.2}, 99th percentile {p99}, max {worst}");
-    // NeuQuant's 256 colours a frame (sampling factor 10) on these frames: measured
-    // mean 2.45 levels, 99th percentile 36, max 91 (the few pixels of a rare colour:
-    // small balls). Factor 1 gives 1.51, 22, 83 at about ten times the time.
-    assert!(
-        mean <= 4.0 && p99 <= 48 && worst <= 128,
-        "mean {mean}, p99 {p99}, max {worst}"
-    );
-}
-
-#[test]
-fn a_slice_of_frames_equals_the_same_frames_of_the_whole_run() {
-    let dir = tempfile::tempdir().unwrap();
-    let dir = dir.path();
-    let scene = spin_file(dir);
-    run(&["render", &scene, "-q", "-o", "all-%02d.ppm"], dir);
-    run(
-        &[
-            "render",
-            &scene,
-            "-q",
-            "--frame",
-            "2..5",
-            "-o",
-            "part-%02d.ppm",
-        ],
-        dir,
-    );
-    run(
-        &["render", &scene, "-q", "--frame", "4", "-o", "one.ppm"],
-        dir,
-    );
-    let read = |name: String| std::fs::read(dir.join(name)).unwrap();
-    for k in 2..5 {
-        assert!(
-            read(format!("part-{k:02}.ppm")) == read(format!("all-{k:02}.ppm")),
-            "frame {k}"
-        );
-    }
-    for k in [0, 1, 5] {
-        assert!(
-            !dir.join(format!("part-{k:02}.ppm")).exists(),
-            "frame {k} is outside 2..5"
-        );
-    }
-    assert!(read("one.ppm".into()) == read("all-04.ppm".into()));
-    // Frame 0 of the turntable is the still scene's image.
-    let still = parse(&std::fs::read_to_string(dir.join("spin.toml")).unwrap());
-    let mut still = still;
-    still.animation = None;
-    std::fs::write(dir.join("still.toml"), to_toml(&still)).unwrap();
-    run(&["render", "still.toml", "-q", "-o", "still.ppm"], dir);
-    assert!(read("still.ppm".into()) == read("all-00.ppm".into()));
-}
-
-#[test]
-fn animation_options_override_the_scene_and_bad_ones_say_why() {
-    let dir = tempfile::tempdir().unwrap();
-    let dir = dir.path();
-    // --frames and --orbit on the still built-in scene: 3 numbered files.
-    run(
-        &[
-            "render", "-q", "--width", "32", "--height", "18", "--frames", "3", "--orbit", "30",
-            "-o", "o-%d.png",
-        ],
-        dir,
-    );
-    for k in 0..3 {
-        assert!(dir.join(format!("o-{k}.png")).exists());
-    }
-    let fails = |args: &[&str], code: i32, needle: &str| {
+    fn run(args: &[&str], dir: &Path) -> Output {
         let out = Command::new(BIN)
             .args(args)
             .current_dir(dir)
             .output()
+            .expect("run whitted");
+        assert!(
+            out.status.success(),
+            "whitted {args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    }
+
+    /// A 6-frame turntable of hw3 at 96×54 and 10 fps, written as `spin.toml` in `dir`.
+    fn spin_file(dir: &Path) -> String {
+        let mut scene = turntable(6, 300.0);
+        scene.animation.as_mut().unwrap().fps = 10.0;
+        scene.image.width = Some(96);
+        scene.image.height = Some(54);
+        let path = dir.join("spin.toml");
+        std::fs::write(&path, to_toml(&scene)).unwrap();
+        path.to_str().unwrap().to_string()
+    }
+
+    fn png(path: &Path) -> RgbImage {
+        image::open(path)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+            .to_rgb8()
+    }
+
+    fn rgb(frame: image::Frame) -> RgbImage {
+        image::DynamicImage::ImageRgba8(frame.into_buffer()).to_rgb8()
+    }
+
+    #[test]
+    fn gif_and_apng_hold_the_numbered_frames() {
+        let dir = tempfile::tempdir().unwrap();
+        let dir = dir.path();
+        let scene = spin_file(dir);
+        run(
+            &[
+                "render",
+                &scene,
+                "-q",
+                "-o",
+                "f-%03d.png",
+                "-o",
+                "spin.gif",
+                "-o",
+                "spin.apng",
+            ],
+            dir,
+        );
+        let numbered: Vec<RgbImage> = (0..6)
+            .map(|k| png(&dir.join(format!("f-{k:03}.png"))))
+            .collect();
+        assert!(
+            numbered.windows(2).all(|w| w[0] != w[1]),
+            "the frames differ"
+        );
+
+        // APNG: lossless, 6 frames of 1/10 s.
+        let file = BufReader::new(std::fs::File::open(dir.join("spin.apng")).unwrap());
+        let decoder = image::codecs::png::PngDecoder::new(file).unwrap();
+        assert!(decoder.is_apng().unwrap());
+        let frames = decoder
+            .apng()
+            .unwrap()
+            .into_frames()
+            .collect_frames()
             .unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
-        assert_eq!(err.lines().count(), 1, "{err}");
-        assert!(err.contains(needle), "{args:?}: {err}");
-    };
-    let small = ["render", "--width", "8", "--height", "8"];
-    let with = |extra: &[&'static str]| [&small[..], extra].concat();
-    fails(
-        &with(&["--frames", "4", "-o", "x.png"]),
-        2,
-        "one image cannot hold 4 frames",
-    );
-    fails(&with(&["--frames", "4"]), 2, "name the files with -o");
-    fails(
-        &with(&["--frames", "4", "--frame", "4", "-o", "x.png"]),
-        2,
-        "has 4 frames (0 to 3)",
-    );
-    fails(&with(&["--frame", "3..1", "-o", "x.png"]), 2, "A < B");
-    fails(&with(&["--orbit", "inf", "-o", "x.gif"]), 2, "finite");
-    fails(&with(&["-o", "x-%02d.gif"]), 2, "no %d pattern");
-    assert!(!dir.join("x.png").exists() && !dir.join("x.gif").exists());
-}
+        assert_eq!(frames.len(), 6);
+        for (k, frame) in frames.into_iter().enumerate() {
+            assert_eq!(frame.delay().numer_denom_ms(), (100, 1), "frame {k}");
+            assert!(
+                rgb(frame) == numbered[k],
+                "APNG frame {k} differs from f-{k:03}.png"
+            );
+        }
 
-#[test]
-fn delays_follow_the_frame_rate() {
-    assert_eq!(image_io::gif_delay_centiseconds(24.0), 4);
-    assert_eq!(image_io::gif_delay_centiseconds(10.0), 10);
-    assert_eq!(
-        image_io::gif_delay_centiseconds(100.0),
-        2,
-        "browsers' minimum"
-    );
-    assert_eq!(image_io::apng_delay(24.0), (1, 24));
-    assert_eq!(image_io::apng_delay(29.97), (334, 10_000));
-}
+        // GIF: 6 frames of 10/100 s, each within its palette's error of the PNG.
+        let file = BufReader::new(std::fs::File::open(dir.join("spin.gif")).unwrap());
+        let frames = image::codecs::gif::GifDecoder::new(file)
+            .unwrap()
+            .into_frames()
+            .collect_frames()
+            .unwrap();
+        assert_eq!(frames.len(), 6);
+        let mut errors: Vec<u8> = Vec::new();
+        for (k, frame) in frames.into_iter().enumerate() {
+            assert_eq!(frame.delay().numer_denom_ms(), (100, 1), "frame {k}");
+            let decoded = rgb(frame);
+            assert_eq!(decoded.dimensions(), (96, 54));
+            let pixels = decoded.pixels().zip(numbered[k].pixels());
+            errors.extend(pixels.map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap()));
+        }
+        errors.sort_unstable();
+        let mean = errors.iter().map(|&d| f64::from(d)).sum::<f64>() / errors.len() as f64;
+        let p99 = errors[errors.len() * 99 / 100];
+        let worst = errors[errors.len() - 1];
+        println!("GIF palette error per pixel: mean {mean:.2}, 99th percentile {p99}, max {worst}");
+        // NeuQuant's 256 colours a frame (sampling factor 10) on these frames: measured
+        // mean 2.45 levels, 99th percentile 36, max 91 (the few pixels of a rare colour:
+        // small balls). Factor 1 gives 1.51, 22, 83 at about ten times the time.
+        assert!(
+            mean <= 4.0 && p99 <= 48 && worst <= 128,
+            "mean {mean}, p99 {p99}, max {worst}"
+        );
+    }
 
-#[test]
-fn the_committed_turntable_gif_is_the_turntable_scene() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let scene = Scene::load(&root.join("assets/scenes/turntable.toml")).unwrap();
-    let animation = scene.animation.clone().unwrap();
-    assert_eq!(animation.motion, Motion::Orbit { degrees: 360.0 });
-    let file = BufReader::new(std::fs::File::open(root.join("assets/turntable.gif")).unwrap());
-    let frames = image::codecs::gif::GifDecoder::new(file)
-        .unwrap()
-        .into_frames()
-        .collect_frames()
-        .unwrap();
-    assert_eq!(frames.len() as u32, animation.frames);
-    let settings = scene.settings();
-    assert_eq!(
-        frames[0].buffer().dimensions(),
-        (settings.width, settings.height)
-    );
-    // Frame 0 of the file is the still scene's image, within the palette's error.
-    let mut still = scene.clone();
-    still.animation = None;
-    let (frame, _) = render::render(&still, &settings, &RenderControl::default()).unwrap();
-    let expected = image_io::to_rgb8(&frame, Encoding::Linear);
-    let decoded = rgb(frames.into_iter().next().unwrap());
-    let off = decoded
-        .pixels()
-        .zip(expected.pixels())
-        .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 48))
-        .count();
-    assert!(off * 100 < expected.len() / 3, "{off} pixels far off");
+    #[test]
+    fn a_slice_of_frames_equals_the_same_frames_of_the_whole_run() {
+        let dir = tempfile::tempdir().unwrap();
+        let dir = dir.path();
+        let scene = spin_file(dir);
+        run(&["render", &scene, "-q", "-o", "all-%02d.ppm"], dir);
+        run(
+            &[
+                "render",
+                &scene,
+                "-q",
+                "--frame",
+                "2..5",
+                "-o",
+                "part-%02d.ppm",
+            ],
+            dir,
+        );
+        run(
+            &["render", &scene, "-q", "--frame", "4", "-o", "one.ppm"],
+            dir,
+        );
+        let read = |name: String| std::fs::read(dir.join(name)).unwrap();
+        for k in 2..5 {
+            assert!(
+                read(format!("part-{k:02}.ppm")) == read(format!("all-{k:02}.ppm")),
+                "frame {k}"
+            );
+        }
+        for k in [0, 1, 5] {
+            assert!(
+                !dir.join(format!("part-{k:02}.ppm")).exists(),
+                "frame {k} is outside 2..5"
+            );
+        }
+        assert!(read("one.ppm".into()) == read("all-04.ppm".into()));
+        // Frame 0 of the turntable is the still scene's image.
+        let still = parse(&std::fs::read_to_string(dir.join("spin.toml")).unwrap());
+        let mut still = still;
+        still.animation = None;
+        std::fs::write(dir.join("still.toml"), to_toml(&still)).unwrap();
+        run(&["render", "still.toml", "-q", "-o", "still.ppm"], dir);
+        assert!(read("still.ppm".into()) == read("all-00.ppm".into()));
+    }
+
+    #[test]
+    fn animation_options_override_the_scene_and_bad_ones_say_why() {
+        let dir = tempfile::tempdir().unwrap();
+        let dir = dir.path();
+        // --frames and --orbit on the still built-in scene: 3 numbered files.
+        run(
+            &[
+                "render", "-q", "--width", "32", "--height", "18", "--frames", "3", "--orbit",
+                "30", "-o", "o-%d.png",
+            ],
+            dir,
+        );
+        for k in 0..3 {
+            assert!(dir.join(format!("o-{k}.png")).exists());
+        }
+        let fails = |args: &[&str], code: i32, needle: &str| {
+            let out = Command::new(BIN)
+                .args(args)
+                .current_dir(dir)
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+            assert_eq!(err.lines().count(), 1, "{err}");
+            assert!(err.contains(needle), "{args:?}: {err}");
+        };
+        let small = ["render", "--width", "8", "--height", "8"];
+        let with = |extra: &[&'static str]| [&small[..], extra].concat();
+        fails(
+            &with(&["--frames", "4", "-o", "x.png"]),
+            2,
+            "one image cannot hold 4 frames",
+        );
+        fails(&with(&["--frames", "4"]), 2, "name the files with -o");
+        fails(
+            &with(&["--frames", "4", "--frame", "4", "-o", "x.png"]),
+            2,
+            "has 4 frames (0 to 3)",
+        );
+        fails(&with(&["--frame", "3..1", "-o", "x.png"]), 2, "A < B");
+        fails(&with(&["--orbit", "inf", "-o", "x.gif"]), 2, "finite");
+        fails(&with(&["-o", "x-%02d.gif"]), 2, "no %d pattern");
+        assert!(!dir.join("x.png").exists() && !dir.join("x.gif").exists());
+    }
+
+    #[test]
+    fn delays_follow_the_frame_rate() {
+        assert_eq!(image_io::gif_delay_centiseconds(24.0), 4);
+        assert_eq!(image_io::gif_delay_centiseconds(10.0), 10);
+        assert_eq!(
+            image_io::gif_delay_centiseconds(100.0),
+            2,
+            "browsers' minimum"
+        );
+        assert_eq!(image_io::apng_delay(24.0), (1, 24));
+        assert_eq!(image_io::apng_delay(29.97), (334, 10_000));
+    }
+
+    #[test]
+    fn the_committed_turntable_gif_is_the_turntable_scene() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let scene = Scene::load(&root.join("assets/scenes/turntable.toml")).unwrap();
+        let animation = scene.animation.clone().unwrap();
+        assert_eq!(animation.motion, Motion::Orbit { degrees: 360.0 });
+        let file = BufReader::new(std::fs::File::open(root.join("assets/turntable.gif")).unwrap());
+        let frames = image::codecs::gif::GifDecoder::new(file)
+            .unwrap()
+            .into_frames()
+            .collect_frames()
+            .unwrap();
+        assert_eq!(frames.len() as u32, animation.frames);
+        let settings = scene.settings();
+        assert_eq!(
+            frames[0].buffer().dimensions(),
+            (settings.width, settings.height)
+        );
+        // Frame 0 of the file is the still scene's image, within the palette's error.
+        let mut still = scene.clone();
+        still.animation = None;
+        let (frame, _) = render::render(&still, &settings, &RenderControl::default()).unwrap();
+        let expected = image_io::to_rgb8(&frame, Encoding::Linear);
+        let decoded = rgb(frames.into_iter().next().unwrap());
+        let off = decoded
+            .pixels()
+            .zip(expected.pixels())
+            .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 48))
+            .count();
+        assert!(off * 100 < expected.len() / 3, "{off} pixels far off");
+    }
 }

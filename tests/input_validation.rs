@@ -3,12 +3,10 @@
 //! before any allocation, and giant images refused by the command line. An error is one
 //! line (the loader's start with the file and position); nothing panics, and nothing
 //! the limits forbid is allocated.
-#![cfg(all(feature = "cli", feature = "viewer"))]
 
 mod support;
 
 use std::cell::RefCell;
-use std::process::Command;
 use std::time::Instant;
 
 use proptest::prelude::*;
@@ -393,13 +391,15 @@ fn files_too_large_or_not_text_are_refused_before_reading() {
     assert!(e.to_string().contains("missing.toml"), "{e}");
 }
 
-fn whitted() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_whitted"))
+#[cfg(all(feature = "cli", feature = "viewer"))] // the binary needs both features
+fn whitted() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_whitted"))
 }
 
 /// A giant image from the command line or from the file is refused before anything is
 /// allocated (65536² pixels of 12 bytes would be 51 GB: an attempt would abort, not
 /// print one line and exit 1).
+#[cfg(all(feature = "cli", feature = "viewer"))]
 #[test]
 fn giant_images_are_refused_by_the_command_line() {
     let dir = tempfile::tempdir().unwrap();
