@@ -5,7 +5,7 @@
 
 use image::{DynamicImage, RgbImage};
 
-use crate::image_io::{to_byte, to_rgb8, Encoding};
+use crate::image_io::{to_byte, to_rgb32f};
 use crate::render::Frame;
 
 /// Errors of an image against the reference, both clamped to [0,1] as displayed.
@@ -42,21 +42,7 @@ pub struct Levels {
 impl Levels {
     /// A render, as its linear 8-bit file shows it (values: `clamp(c)·255`).
     pub fn from_frame(frame: &Frame) -> Levels {
-        let w = frame.width.max(1) as usize;
-        let values = frame
-            .pixels
-            .chunks_exact(w)
-            .rev()
-            .flatten()
-            .flat_map(|p| p.to_array())
-            .map(|c| f64::from(c.clamp(0.0, 1.0)) * 255.0)
-            .collect();
-        Levels {
-            width: frame.width,
-            height: frame.height,
-            values,
-            bytes: to_rgb8(frame, Encoding::Linear),
-        }
+        Levels::from_image(DynamicImage::ImageRgb32F(to_rgb32f(frame)))
     }
 
     /// A decoded image file: 8-bit (or 16-bit) images by their bytes, floating-point

@@ -125,6 +125,13 @@ fn measure_scene(
 ) -> anyhow::Result<Vec<Row>> {
     bar.set_message(format!("{}: reference (f64, 256 spp, depth 16)", bs.name));
     let refr: Reference = reference(&bs.scene, opts, &opts.out.join("cache"))?;
+    // The reference's levels, made once for every setting's comparison.
+    let reference_levels = Levels::from_frame(&refr.frame);
+    let against_reference = |frame: &crate::render::Frame| {
+        measure(&Levels::from_frame(frame), &reference_levels)
+            .expect("renders of one size")
+            .errors
+    };
     bar.inc(1);
     // A first, untimed render of every setting gives the image (and warms up).
     // The timed runs then cycle through the settings, so that a burst of load from
@@ -157,7 +164,7 @@ fn measure_scene(
             min_s: 0.0,
             rays: m.rays,
             refined: m.refined,
-            errors: compare(&m.frame, &refr.frame),
+            errors: against_reference(&m.frame),
             cutoff_bound: m.cutoff_bound,
             cutoff_error,
             pareto: false,
@@ -195,7 +202,7 @@ fn measure_scene(
         min_s: refr.seconds,
         rays: refr.rays,
         refined: 1.0,
-        errors: compare(&refr.frame, &refr.frame),
+        errors: against_reference(&refr.frame),
         cutoff_bound: 0.0,
         cutoff_error: 0,
         pareto: false,

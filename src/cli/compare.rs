@@ -19,7 +19,7 @@ pub(crate) struct CompareArgs {
     /// Write FLIP's per-pixel difference here as a colour-mapped image (magma: black
     /// is no difference, light yellow the largest); format by extension.
     #[arg(long, value_name = "FILE", value_parser = parse_heat_map)]
-    heatmap: Option<PathBuf>,
+    heatmap: Option<HeatMap>,
     /// Exit with status 1 when the RMSE (8-bit levels) is above this.
     #[arg(long, value_name = "X", value_parser = parse_limit)]
     max_rmse: Option<f64>,
@@ -36,12 +36,18 @@ fn parse_limit(text: &str) -> Result<f64, String> {
     }
 }
 
-/// A heat map path in an 8-bit format.
-fn parse_heat_map(text: &str) -> Result<PathBuf, String> {
+/// Where the heat map goes, in an 8-bit format.
+#[derive(Clone, Debug)]
+struct HeatMap {
+    path: PathBuf,
+    format: Format,
+}
+
+fn parse_heat_map(text: &str) -> Result<HeatMap, String> {
     let path = PathBuf::from(text);
     match Format::from_path(&path, true).map_err(|e| e.to_string())? {
         Format::Exr => Err("a heat map is an 8-bit image: use .png, .ppm, .bmp or .jpg".into()),
-        _ => Ok(path),
+        format => Ok(HeatMap { path, format }),
     }
 }
 
@@ -67,8 +73,8 @@ pub(crate) fn line(e: &Errors) -> String {
 }
 
 pub(crate) fn compare_command(args: CompareArgs) -> anyhow::Result<()> {
-    if let Some(path) = &args.heatmap {
-        image_io::check_writable(path)?;
+    if let Some(heat) = &args.heatmap {
+        image_io::check_writable(&heat.path)?;
     }
     let (a, b) = (load(&args.a)?, load(&args.b)?);
     let Some(comparison) = measure(&a, &b) else {
@@ -84,9 +90,8 @@ pub(crate) fn compare_command(args: CompareArgs) -> anyhow::Result<()> {
     };
     let errors = comparison.errors;
     println!("{}", line(&errors));
-    if let Some(path) = &args.heatmap {
-        let format = Format::from_path(path, true)?;
-        image_io::save_rgb8(&comparison.heat_map(), path, format)?;
+    if let Some(heat) = &args.heatmap {
+        image_io::save_rgb8(&comparison.heat_map(), &heat.path, heat.format)?;
     }
     let over1 = errors.off_by_more_than_1 * 100.0;
     if let Some(limit) = args.max_rmse.filter(|&l| errors.rmse > l) {

@@ -29,13 +29,13 @@ pub fn report(
     let camera = scene
         .camera(width, height)
         .map_err(|e| format!("camera: {e}"))?;
-    let tracer = ReferenceTracer::new(scene, camera, scene.settings().quality.max_depth);
+    let settings = scene.settings();
+    let tracer = ReferenceTracer::new(scene, camera, settings.quality.max_depth);
     let s = (f64::from(i) + 0.5) / f64::from(width);
     let t = (f64::from(j) + 0.5) / f64::from(height);
     let (colour, tree) = tracer.inspect(s, t);
-    let bytes = shown
-        .to_array()
-        .map(|c| ByteEncoder::new(scene.settings().encoding).byte(c));
+    let encoder = ByteEncoder::new(settings.encoding);
+    let bytes = shown.to_array().map(|c| encoder.byte(c));
     let mut out = String::new();
     let _ = writeln!(
         out,
