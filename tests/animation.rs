@@ -587,12 +587,26 @@ mod command_line {
         still.animation = None;
         let (frame, _) = render::render(&still, &settings, &RenderControl::default()).unwrap();
         let expected = image_io::to_rgb8(&frame, Encoding::Linear);
-        let decoded = rgb(frames.into_iter().next().unwrap());
-        let off = decoded
-            .pixels()
-            .zip(expected.pixels())
-            .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 48))
-            .count();
+        let far_off = |decoded: &RgbImage, expected: &RgbImage| {
+            decoded
+                .pixels()
+                .zip(expected.pixels())
+                .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 48))
+                .count()
+        };
+        let mut frames: Vec<RgbImage> = frames.into_iter().map(rgb).collect();
+        let off = far_off(&frames[0], &expected);
         assert!(off * 100 < expected.len() / 3, "{off} pixels far off");
+        // A frame half way round is that frame of the scene (a stale file with another
+        // orbit would still match at frame 0).
+        let k = animation.frames / 2;
+        let turned = scene.frame(k, settings.width, settings.height);
+        let (frame, _) = render::render(&turned, &settings, &RenderControl::default()).unwrap();
+        let expected = image_io::to_rgb8(&frame, Encoding::Linear);
+        let off = far_off(&frames.swap_remove(k as usize), &expected);
+        assert!(
+            off * 100 < expected.len() / 3,
+            "frame {k}: {off} pixels far off"
+        );
     }
 }

@@ -133,12 +133,14 @@ fn files_hold_srgb_bytes_and_exr_stays_linear() {
 #[test]
 fn without_the_key_files_hold_the_linear_bytes() {
     let f = frame();
-    let linear = image_io::to_rgb8(&f, Encoding::Linear);
-    for (p, px) in f.pixels.chunks(4).rev().flatten().zip(linear.pixels()) {
-        assert_eq!(px.0, p.to_array().map(to_byte));
-    }
     let scene = hw3_scene(HW3_DEFAULT_SEED);
     assert_eq!(scene.settings().encoding, Encoding::Linear);
+    // A PNG written with the scene's own encoding, decoded: the linear bytes.
+    let png = image_io::encode(&f, Format::Png, scene.settings().encoding).unwrap();
+    let decoded = image::load_from_memory(&png).unwrap().into_rgb8();
+    for (p, px) in f.pixels.chunks(4).rev().flatten().zip(decoded.pixels()) {
+        assert_eq!(px.0, p.to_array().map(to_byte));
+    }
 }
 
 #[cfg(all(feature = "cli", feature = "viewer"))]
