@@ -21,7 +21,7 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::camera::CameraError;
+use crate::camera::{Camera, CameraError};
 use crate::scene::Scene;
 use crate::settings::{Adaptive, Precision, Region, Settings, SettingsError};
 use crate::trace::fast::FastTracer;
@@ -120,7 +120,8 @@ pub fn make_tracer<'a>(
     scene: &'a Scene,
     settings: &Settings,
 ) -> Result<Box<dyn SampleTracer + 'a>, RenderError> {
-    Ok(match Tracer::new(scene, settings)? {
+    let camera = scene.camera(settings.width, settings.height)?;
+    Ok(match Tracer::new(scene, camera, settings, None) {
         Tracer::Fast(t) => Box::new(t),
         Tracer::Reference(t) => Box::new(t),
     })
@@ -135,15 +136,34 @@ enum Tracer<'a> {
 }
 
 impl<'a> Tracer<'a> {
-    fn new(scene: &'a Scene, settings: &Settings) -> Result<Self, RenderError> {
-        let camera = scene.camera(settings.width, settings.height)?;
+    /// The tracer `settings` ask for, seeing `scene` through `camera`. A fast tracer of
+    /// the same scene from an earlier view (`previous`) lends its compiled scene, so
+    /// only the camera's part is built.
+    fn new(
+        scene: &'a Scene,
+        camera: Camera,
+        settings: &Settings,
+        previous: Option<FastTracer>,
+    ) -> Self {
         let depth = settings.quality.max_depth;
-        Ok(match settings.quality.precision {
+        match settings.quality.precision {
             Precision::Fast => Tracer::Fast(
-                FastTracer::new(scene, &camera, depth).with_cutoff(settings.quality.cutoff),
+                match previous {
+                    Some(p) => p.with_camera(&camera, depth),
+                    None => FastTracer::new(scene, &camera, depth),
+                }
+                .with_cutoff(settings.quality.cutoff),
             ),
             Precision::Reference => Tracer::Reference(ReferenceTracer::new(scene, camera, depth)),
-        })
+        }
+    }
+
+    /// The area of `settings`, traced.
+    fn render(&self, settings: &Settings, control: &RenderControl) -> Result<Traced, RenderError> {
+        match self {
+            Tracer::Fast(t) => render_with(t, settings, control),
+            Tracer::Reference(t) => render_with(t, settings, control),
+        }
     }
 }
 
@@ -182,18 +202,16 @@ pub fn render_bounded(
 ) -> Result<Rendered, RenderError> {
     settings.check()?;
     let start = Instant::now();
+    let camera = scene.camera(settings.width, settings.height)?;
     // The build runs on the render's threads too: `--threads 1` means one thread.
-    let tracer = in_pool(settings, || Tracer::new(scene, settings))??;
+    let tracer = in_pool(settings, || Tracer::new(scene, camera, settings, None))?;
     let build_seconds = start.elapsed().as_secs_f64();
     let Traced {
         frame,
         cutoff_bound,
         refined,
         rays,
-    } = match &tracer {
-        Tracer::Fast(t) => render_with(t, settings, control)?,
-        Tracer::Reference(t) => render_with(t, settings, control)?,
-    };
+    } = tracer.render(settings, control)?;
     Ok(Rendered {
         frame,
         cutoff_bound,

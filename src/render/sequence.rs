@@ -9,13 +9,12 @@
 use std::time::Instant;
 
 use super::bands::in_pool;
-use super::{render_with, RenderError, RenderStats, Traced};
+use super::{RenderError, RenderStats, Traced, Tracer};
 use crate::camera::{Camera, CameraSpec};
 use crate::render::{Frame, RenderControl};
 use crate::scene::Scene;
-use crate::settings::{Precision, Settings};
+use crate::settings::Settings;
 use crate::trace::fast::FastTracer;
-use crate::trace::reference::ReferenceTracer;
 
 /// Renders `scene` from one camera after another, compiling it once.
 pub struct Sequence<'a> {
@@ -40,27 +39,16 @@ impl<'a> Sequence<'a> {
         settings.check()?;
         let start = Instant::now();
         let camera = Camera::new(camera, settings.width, settings.height)?;
-        let depth = settings.quality.max_depth;
-        let traced = match settings.quality.precision {
-            Precision::Fast => {
-                let previous = self.fast.take();
-                let scene = self.scene;
-                let tracer = in_pool(settings, || match previous {
-                    Some(p) => p.with_camera(&camera, depth),
-                    None => FastTracer::new(scene, &camera, depth),
-                })?
-                .with_cutoff(settings.quality.cutoff);
-                let build_seconds = start.elapsed().as_secs_f64();
-                let traced = render_with(&tracer, settings, control);
-                self.fast = Some(tracer);
-                (traced?, build_seconds)
-            }
-            Precision::Reference => {
-                let tracer = ReferenceTracer::new(self.scene, camera, depth);
-                (render_with(&tracer, settings, control)?, 0.0)
-            }
-        };
-        let (Traced { frame, rays, .. }, build_seconds) = traced;
+        let previous = self.fast.take();
+        let tracer = in_pool(settings, || {
+            Tracer::new(self.scene, camera, settings, previous)
+        })?;
+        let build_seconds = start.elapsed().as_secs_f64();
+        let traced = tracer.render(settings, control);
+        if let Tracer::Fast(fast) = tracer {
+            self.fast = Some(fast);
+        }
+        let Traced { frame, rays, .. } = traced?;
         Ok((
             frame,
             RenderStats {
