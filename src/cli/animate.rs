@@ -12,10 +12,10 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{sync_channel, Receiver};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::{anyhow, Context};
 use clap::Args;
@@ -264,7 +264,13 @@ pub(crate) fn render_frames(
     }
     let done = Arc::new(AtomicU64::new(0));
     let show_progress = !quiet && std::io::stderr().is_terminal();
-    let progress = show_progress.then(|| spawn_progress(Arc::clone(&done), u64::from(count)));
+    let progress = show_progress.then(|| {
+        let done = Arc::clone(&done);
+        super::Progress::start(
+            "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} frames ETA {eta}",
+            move || (done.load(Ordering::Relaxed), u64::from(count)),
+        )
+    });
 
     // A rendezvous: the render hands a frame over only once the writer has finished
     // the one before.
@@ -316,9 +322,8 @@ pub(crate) fn render_frames(
         .join()
         .map_err(|_| anyhow!("the writer thread panicked"))?;
     let seconds = start.elapsed().as_secs_f64();
-    if let Some((finished, handle)) = progress {
-        finished.store(true, Ordering::Relaxed);
-        let _ = handle.join();
+    if let Some(progress) = progress {
+        progress.finish();
     }
     let written = written?;
     if let Some(e) = stopped {
@@ -413,39 +418,6 @@ fn write_frames(
         writer.finish()?;
     }
     Ok(written)
-}
-
-/// A progress bar of frames on stderr that appears once the render has run a second.
-fn spawn_progress(
-    done: Arc<AtomicU64>,
-    total: u64,
-) -> (Arc<AtomicBool>, std::thread::JoinHandle<()>) {
-    let finished = Arc::new(AtomicBool::new(false));
-    let stop = Arc::clone(&finished);
-    let handle = std::thread::spawn(move || {
-        let start = Instant::now();
-        let mut bar: Option<indicatif::ProgressBar> = None;
-        while !stop.load(Ordering::Relaxed) {
-            std::thread::sleep(Duration::from_millis(50));
-            if bar.is_none() && start.elapsed() > Duration::from_secs(1) {
-                let b = indicatif::ProgressBar::new(total);
-                b.set_style(
-                    indicatif::ProgressStyle::with_template(
-                        "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} frames ETA {eta}",
-                    )
-                    .expect("a valid template"),
-                );
-                bar = Some(b);
-            }
-            if let Some(b) = &bar {
-                b.set_position(done.load(Ordering::Relaxed));
-            }
-        }
-        if let Some(b) = bar {
-            b.finish_and_clear();
-        }
-    });
-    (finished, handle)
 }
 
 #[cfg(test)]

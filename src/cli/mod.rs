@@ -107,3 +107,54 @@ pub(crate) fn time_command(
     println!("{}", timing.result_line(&name, &opts, scene.spheres.len()));
     Ok(())
 }
+
+/// A progress bar on stderr that appears once the work has run for a second (shorter
+/// work shows none), its clock counting from the start.
+pub(crate) struct Progress {
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    thread: std::thread::JoinHandle<()>,
+}
+
+impl Progress {
+    /// Starts watching: `at` gives the work done and the work in all, `template` is
+    /// indicatif's.
+    pub(crate) fn start(
+        template: &'static str,
+        at: impl Fn() -> (u64, u64) + Send + 'static,
+    ) -> Progress {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        use std::time::{Duration, Instant};
+        let stop = std::sync::Arc::new(AtomicBool::new(false));
+        let stopped = std::sync::Arc::clone(&stop);
+        let thread = std::thread::spawn(move || {
+            let start = Instant::now();
+            let mut bar: Option<indicatif::ProgressBar> = None;
+            while !stopped.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(50));
+                let (done, total) = at();
+                if bar.is_none() && start.elapsed() > Duration::from_secs(1) {
+                    let b = indicatif::ProgressBar::new(total).with_elapsed(start.elapsed());
+                    b.set_style(
+                        indicatif::ProgressStyle::with_template(template)
+                            .expect("a valid template"),
+                    );
+                    bar = Some(b);
+                }
+                if let Some(b) = &bar {
+                    b.set_length(total.max(1));
+                    b.set_position(done);
+                }
+            }
+            if let Some(b) = bar {
+                b.finish_and_clear();
+            }
+        });
+        Progress { stop, thread }
+    }
+
+    /// Stops and clears the bar.
+    pub(crate) fn finish(self) {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        let _ = self.thread.join();
+    }
+}

@@ -4,7 +4,6 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Context};
 use clap::Args;
@@ -157,12 +156,17 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     }
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let area = opts.area();
-    let progress = show_progress.then(|| spawn_progress(Arc::clone(&control)));
+    let progress = show_progress.then(|| {
+        let control = Arc::clone(&control);
+        super::Progress::start(
+            "{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}",
+            move || (control.pixels_done(), control.samples_total()),
+        )
+    });
 
     let result = render::render(&scene, &opts, &control);
-    if let Some((done, handle)) = progress {
-        done.store(true, std::sync::atomic::Ordering::Relaxed);
-        let _ = handle.join();
+    if let Some(progress) = progress {
+        progress.finish();
     }
     let (frame, stats) = result.map_err(|e| match e {
         render::RenderError::Cancelled => anyhow!("interrupted: no file was written"),
@@ -221,45 +225,4 @@ pub(crate) fn sampling(quality: &Quality, samples: u64, area: Region) -> String 
         }
         _ => format!("{} spp, {depth}", quality.spp),
     }
-}
-
-/// A progress bar on stderr that appears only once a render has run for a second. It
-/// counts the samples traced against the render's total, which adaptive
-/// anti-aliasing revises as its first pass shows which pixels need more; its clock
-/// starts with the render.
-fn spawn_progress(
-    control: Arc<RenderControl>,
-) -> (
-    Arc<std::sync::atomic::AtomicBool>,
-    std::thread::JoinHandle<()>,
-) {
-    use std::sync::atomic::{AtomicBool, Ordering};
-    let done = Arc::new(AtomicBool::new(false));
-    let finished = Arc::clone(&done);
-    let handle = std::thread::spawn(move || {
-        let start = Instant::now();
-        let mut bar: Option<indicatif::ProgressBar> = None;
-        while !finished.load(Ordering::Relaxed) {
-            std::thread::sleep(Duration::from_millis(50));
-            if bar.is_none() && start.elapsed() > Duration::from_secs(1) {
-                let b = indicatif::ProgressBar::new(control.samples_total())
-                    .with_elapsed(start.elapsed());
-                b.set_style(
-                    indicatif::ProgressStyle::with_template(
-                        "{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}",
-                    )
-                    .expect("a valid template"),
-                );
-                bar = Some(b);
-            }
-            if let Some(b) = &bar {
-                b.set_length(control.samples_total().max(1));
-                b.set_position(control.pixels_done());
-            }
-        }
-        if let Some(b) = bar {
-            b.finish_and_clear();
-        }
-    });
-    (done, handle)
 }
