@@ -15,31 +15,29 @@ use crate::trace::RayCounts;
 pub(super) const BAND_ROWS: usize = 8;
 
 /// Runs `pixel(i, j, state, counts)` for every pixel of `area` (image pixels, `j` from
-/// the bottom) on the thread pool of `settings`. `states` holds `per_pixel` items for each
-/// pixel of the area, row 0 at the bottom of the area. Progress counts `samples` per
-/// pixel.
+/// the bottom) on the thread pool of `settings`. `states` holds one item for each pixel
+/// of the area, row 0 at the bottom of the area. Progress counts `samples` per pixel.
 pub(super) fn for_each_pixel<T, F>(
     settings: &Settings,
     area: Region,
     states: &mut [T],
-    per_pixel: usize,
     samples: u64,
     control: &RenderControl,
     pixel: F,
 ) -> Result<RayCounts, RenderError>
 where
     T: Send,
-    F: Fn(u32, u32, &mut [T], &mut RayCounts) + Sync,
+    F: Fn(u32, u32, &mut T, &mut RayCounts) + Sync,
 {
     for_each_row(
         settings,
         area,
         states,
-        per_pixel,
+        1,
         samples,
         control,
         |j, row, counts| {
-            for (a, state) in row.chunks_mut(per_pixel).enumerate() {
+            for (a, state) in row.iter_mut().enumerate() {
                 pixel(area.x + a as u32, j, state, counts);
             }
         },

@@ -388,11 +388,9 @@ fn render_with<T: SampleTracer>(
                 settings,
                 area,
                 &mut acc,
-                1,
                 u64::from(spp),
                 control,
-                |i, j, p, counts| {
-                    let (sum, bound) = &mut p[0];
+                |i, j, (sum, bound), counts| {
                     for k in 0..spp {
                         let (s, t) = film(settings, i, j, k);
                         let (c, b) = tracer.sample_bounded(s, t, counts);

@@ -52,13 +52,13 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
     }
     let n = samples.len() as u64;
     let afresh = samples.start == 0;
-    for_each_pixel(settings, area, sums, 1, n, control, |i, j, sum, counts| {
+    for_each_pixel(settings, area, sums, n, control, |i, j, sum, counts| {
         if afresh {
-            sum[0] = Vec3::ZERO;
+            *sum = Vec3::ZERO;
         }
         for k in samples.clone() {
             let (s, t) = film(settings, i, j, k);
-            sum[0] += tracer.sample(s, t, counts);
+            *sum += tracer.sample(s, t, counts);
         }
     })
 }
