@@ -76,8 +76,6 @@ def render_tiles(
     ``region`` or ``tile``). ``on_tile(done, total)`` is called as tiles arrive.
     Bad options raise ``ValueError`` before anything is sent; a failing task raises
     its error here."""
-    from distributed import as_completed
-
     if "region" in options or "tile" in options:
         raise ValueError("render_tiles renders the whole image: no region or tile")
     (width, height), _ = whitted.plan(scene, **options)
@@ -88,24 +86,30 @@ def render_tiles(
     dtype = np.float32 if linear else np.uint8
     image = np.empty((height, width, 3), dtype=dtype)
     task_options = dict(options, linear=linear)
+    jobs = [(i, count, task_options) for i in range(count)]
+    for done, ((x, y, w, h), part) in enumerate(_as_they_finish(client, _render_tile, scene, jobs), 1):
+        image[y : y + h, x : x + w] = part
+        if on_tile is not None:
+            on_tile(done, count)
+    return image
+
+
+def _as_they_finish(client: Any, task: Callable, scene: whitted.Scene, jobs: list) -> Iterable:
+    """The results of ``task(scene, *job)`` for each job on the cluster, in the order
+    they finish; a task's error is raised here, and then, or if the caller stops
+    early, the tasks still queued are cancelled."""
+    from distributed import as_completed
+
     # A key of its own (hash=False): a scattered value shared by key with an earlier
     # job would be released when that job's future goes, cancelling this job's tasks.
     scene_future = client.scatter(scene, broadcast=False, hash=False)
-    futures = [
-        client.submit(_render_tile, scene_future, i, count, task_options, pure=False)
-        for i in range(count)
-    ]
+    futures = [client.submit(task, scene_future, *job, pure=False) for job in jobs]
     try:
-        for done, future in enumerate(as_completed(futures), 1):
-            region, part = future.result()  # raises the task's error
-            x, y, w, h = region
-            image[y : y + h, x : x + w] = part
-            if on_tile is not None:
-                on_tile(done, count)
+        for future in as_completed(futures):
+            yield future.result()
     except BaseException:
         client.cancel(futures)
         raise
-    return image
 
 
 def _render_frame(scene: whitted.Scene, k: int, options: dict) -> tuple:
@@ -146,26 +150,16 @@ def render_frames(
     ``whitted render -o PATTERN --frame K``. ``frames``: all (``None``), one, or an
     iterable of frame numbers. Returns the paths in frame order. ``on_frame(done,
     total)`` is called as frames are written."""
-    from distributed import as_completed
-
     numbers = frame_numbers(scene, frames)
     if "frame" in options:
         raise ValueError("render_frames takes the frames as `frames`")
     whitted.plan(scene, **options)  # ValueError before anything is sent
     paths = {k: pattern % k for k in numbers}
-    # A key of its own (hash=False): a scattered value shared by key with an earlier
-    # job would be released when that job's future goes, cancelling this job's tasks.
-    scene_future = client.scatter(scene, broadcast=False, hash=False)
-    futures = [client.submit(_render_frame, scene_future, k, options, pure=False) for k in numbers]
-    try:
-        for done, future in enumerate(as_completed(futures), 1):
-            k, image = future.result()  # raises the task's error
-            whitted.write_image(paths[k], image)
-            if on_frame is not None:
-                on_frame(done, len(numbers))
-    except BaseException:
-        client.cancel(futures)
-        raise
+    jobs = [(k, options) for k in numbers]
+    for done, (k, image) in enumerate(_as_they_finish(client, _render_frame, scene, jobs), 1):
+        whitted.write_image(paths[k], image)
+        if on_frame is not None:
+            on_frame(done, len(numbers))
     return [paths[k] for k in numbers]
 
 
