@@ -1,21 +1,27 @@
 #!/usr/bin/env bash
-# Times whitted on the peers' scenes, in the form of ../shared/peers/run.sh's RESULT
-# lines, next to the peers built by run.sh, in one sitting:
+# whitted against the Embree peer of ../shared/peers, measured as users run them: a
+# fresh process per run on both sides, acceleration build plus render inside the
+# timer (whitted: the closing line of `whitted render`; the peer: build_s + render_s),
+# the two alternated run by run in one sitting, medians. whitted's warm in-process
+# figures (`whitted time`: median of renders after a warm-up, build apart, the
+# viewer's case) are printed beside them, never instead of them.
 #
-#   QUICK=1 ../shared/peers/run.sh      # builds the peers, writes the scenes, times them
-#   scripts/speed.sh                    # hw3 and many_N with whitted and the Embree peer
+#   QUICK=1 ../shared/peers/run.sh      # builds the peers (needs libembree-dev)
+#   scripts/speed.sh                    # the table below, for hw3 and many_N
 #
-# Both print the median of RUNS runs as render_s and the best as best_s.
+# Columns: Embree and whitted cold (median s), whitted ÷ Embree, whitted's warm
+# render and build (median s, `whitted time`), Embree's build (median s), and the
+# peak resident memory of `whitted render` (MB, the largest of the runs).
 #
 # Environment: OUT (run.sh's output folder, default /tmp/peers-out), MANY (default
-# "1000 10000 100000"), RUNS (default 7), THREADS (default "1 2"), WHITTED (the binary
-# to time, default: target/release/whitted, built first; another binary, such as the
-# one before a change, is timed as it is).
+# "1000 10000 100000 1000000"), RUNS (default 5), THREADS (default "1 2"), WHITTED
+# (the binary to time, default target/release/whitted, built first), EMBREE (the peer
+# binary, default the newest under $OUT/bin).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${OUT:-/tmp/peers-out}
-MANY=${MANY:-"1000 10000 100000"}
-RUNS=${RUNS:-7}
+MANY=${MANY:-"1000 10000 100000 1000000"}
+RUNS=${RUNS:-5}
 THREADS=${THREADS:-"1 2"}
 PEERS=$(cd ../shared/peers && pwd)
 SCN=$OUT/scenes
@@ -28,23 +34,41 @@ if [ -z "${WHITTED:-}" ]; then
     cargo build --release --quiet
     WHITTED=./target/release/whitted
 fi
-EMBREE=$(ls "$OUT"/bin/embree_rays.* 2>/dev/null | tail -1 || true)
+EMBREE=${EMBREE:-$(ls "$OUT"/bin/embree_rays.* 2>/dev/null | tail -1 || true)}
+if [ -z "$EMBREE" ]; then
+    echo "no Embree peer under $OUT/bin: run QUICK=1 ../shared/peers/run.sh first" >&2
+    exit 1
+fi
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
+field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
+
+echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'), $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC'); runs $RUNS"
+printf '| %-12s | %-7s | %-11s | %-12s | %-9s | %-11s | %-12s | %-12s | %-10s |\n' \
+    scene threads "Embree cold" "whitted cold" "whitted ÷" "whitted warm" "whitted build" "Embree build" "peak MB"
+printf '|%s|\n' "--------------|---------|-------------|--------------|-----------|-------------|--------------|--------------|------------"
 for scene in hw3 $(for n in $MANY; do echo "many_$n"; done); do
     for t in $THREADS; do
-        if [ -n "$EMBREE" ]; then
-            # As many runs as whitted's: the RESULT line of the median run (the speed
-            # targets compare medians), with the best of them added as best_s.
-            lines=""
-            for _ in $(seq "$RUNS"); do
-                line=$(NO_BENCH=1 "$EMBREE" "$SCN/$scene.txt" "$OUT/$scene.embree.ppm" "$t" | grep '^RESULT')
-                s=$(sed -n 's/.* render_s=\([^ ]*\).*/\1/p' <<<"$line")
-                lines+="$s $line"$'\n'
-            done
-            sorted=$(sort -g <<<"${lines%$'\n'}")
-            best=$(head -n 1 <<<"$sorted" | cut -d' ' -f1)
-            median=$(sed -n "$(( (RUNS + 1) / 2 ))p" <<<"$sorted" | cut -d' ' -f2-)
-            echo "$median best_s=$best runs=$RUNS"
-        fi
-        "$WHITTED" time "$SCN/$scene.toml" --runs "$RUNS" --threads "$t"
+        : >"$tmp/embree" ; : >"$tmp/ebuild" ; : >"$tmp/whitted" ; : >"$tmp/mem"
+        for _ in $(seq "$RUNS"); do
+            line=$(NO_BENCH=1 "$EMBREE" "$SCN/$scene.txt" "$tmp/e.ppm" "$t" | grep '^RESULT')
+            b=$(field build_s <<<"$line")
+            r=$(field render_s <<<"$line")
+            awk -v b="$b" -v r="$r" 'BEGIN { print b + r }' >>"$tmp/embree"
+            echo "$b" >>"$tmp/ebuild"
+            /usr/bin/time -f '%M' -o "$tmp/rss" "$WHITTED" render "$SCN/$scene.toml" -o "$tmp/w.ppm" \
+                --threads "$t" 2>"$tmp/err" >/dev/null
+            sed -n 's/^rendered .* in \([0-9.]*\) s:.*/\1/p' "$tmp/err" >>"$tmp/whitted"
+            echo $(( $(cat "$tmp/rss") / 1024 )) >>"$tmp/mem"
+        done
+        warm=$("$WHITTED" time "$SCN/$scene.toml" --runs "$RUNS" --threads "$t")
+        e=$(median <"$tmp/embree")
+        w=$(median <"$tmp/whitted")
+        printf '| %-12s | %-7s | %-11.4f | %-12.4f | %-9.2f | %-11s | %-12s | %-12s | %-10s |\n' \
+            "$scene" "$t" "$e" "$w" "$(awk -v w="$w" -v e="$e" 'BEGIN { print w / e }')" \
+            "$(field render_s <<<"$warm")" "$(field build_s <<<"$warm")" \
+            "$(median <"$tmp/ebuild")" "$(sort -g "$tmp/mem" | tail -1)"
     done
 done

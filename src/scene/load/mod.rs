@@ -10,10 +10,12 @@
 //! [`limits::MAX_WHOLE_PARSE_BYTES`]. The sphere count is known from a scan of the
 //! lines before anything is parsed, so a file with too many spheres is refused first.
 //!
-//! The steps: [`schema`] (serde types), [`streaming`] (big files in batches),
+//! The steps: [`schema`] (serde types), [`streaming`] (big files in batches, their
+//! plainly written `[[sphere]]` tables read by [`plain`] without `toml`'s tree),
 //! [`validate`] (values against SPEC §3) and [`messages`] (positions and wording).
 
 mod messages;
+mod plain;
 mod schema;
 mod streaming;
 mod validate;

@@ -7,6 +7,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use super::messages::{from_toml, Locator};
+use super::plain;
 use super::schema::{FileScene, FileSphereTable};
 use super::validate::{settings, sphere};
 use crate::limits;
@@ -83,7 +84,7 @@ impl SphereRun {
 }
 
 /// `[[sphere]]`, spaces allowed inside the brackets, then nothing or a comment.
-fn is_sphere_header(line: &str) -> bool {
+pub(super) fn is_sphere_header(line: &str) -> bool {
     let Some(rest) = line.strip_prefix("[[") else {
         return false;
     };
@@ -114,8 +115,8 @@ pub(super) fn parse_with_run(text: &str, path: &str, run: &SphereRun) -> Result<
     }
     let mut scene = settings(&at, &file)?;
     // Batches of consecutive tables, parsed in parallel: each batch's `toml` tree is
-    // small, and the batches come back in order, so the first error is the first in
-    // the file.
+    // small (plainly written tables build none), and the batches come back in order,
+    // so the first error is the first in the file.
     let mut batches: Vec<(usize, Range<usize>)> = Vec::new();
     for (k, range) in run.tables(text).enumerate() {
         match batches.last_mut() {
@@ -131,9 +132,13 @@ pub(super) fn parse_with_run(text: &str, path: &str, run: &SphereRun) -> Result<
                 path,
                 offset: range.start,
             };
-            let tables: FileSphereTable = from_toml(&text[range.clone()], &batch_at)?;
+            let batch = &text[range.clone()];
+            let count = (run.count - first).min(TABLES_PER_BATCH);
+            let tables = match plain::sphere_tables(batch, count) {
+                Some(tables) => tables,
+                None => from_toml::<FileSphereTable>(batch, &batch_at)?.sphere,
+            };
             tables
-                .sphere
                 .iter()
                 .enumerate()
                 .map(|(i, s)| sphere(&batch_at, s, first + i))
