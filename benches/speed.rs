@@ -1,5 +1,6 @@
 //! Speed benchmarks (`cargo bench`): the intersection kernel, the fast tracer's rays
-//! of one and two bounces, the fast tracer's build (hierarchy and grids), whole frames
+//! of one and two bounces, the fast tracer's build (hierarchy and grids), the walk of
+//! incoherent rays through the hierarchy alone, whole frames
 //! of the peers' scenes, and the viewer's views and screen conversions. Compare runs of
 //! one sitting, as ratios.
 
@@ -10,6 +11,7 @@ use glam::{DVec3, Vec3};
 use whitted::intersect::roots;
 use whitted::render::{render, RenderControl};
 use whitted::scene::{hw3_scene, many_scene, HW3_DEFAULT_SEED};
+use whitted::speed::SecondaryWalk;
 use whitted::trace::fast::FastTracer;
 use whitted::trace::{RayCounts, SampleTracer};
 
@@ -77,6 +79,21 @@ fn build(c: &mut Criterion) {
         // The hierarchy, the lights' grids and the eye grid, with the materials.
         group.bench_function(format!("tracer_many_{n}"), |b| {
             b.iter(|| black_box(FastTracer::new(&scene, &cam, depth)))
+        });
+    }
+    group.finish();
+}
+
+/// The walk of incoherent rays through the hierarchy alone (see
+/// [`whitted::speed::SecondaryWalk`]): many_100000's reflected rays of every fourth
+/// pixel each way of its 1280x720 view, on one thread.
+fn secondary(c: &mut Criterion) {
+    let mut group = c.benchmark_group("secondary");
+    group.sample_size(10);
+    for n in [10_000, 100_000] {
+        let walk = SecondaryWalk::new(&many_scene(n), 1280, 720, 4).expect("camera");
+        group.bench_function(format!("closest_many_{n}_{}_rays", walk.len()), |b| {
+            b.iter(|| black_box(walk.closest_hits()))
         });
     }
     group.finish();
@@ -174,5 +191,5 @@ fn viewer(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, kernel, build, frames, viewer);
+criterion_group!(benches, kernel, build, secondary, frames, viewer);
 criterion_main!(benches);

@@ -215,3 +215,67 @@ pub fn time_orbit(
     timing.wall_seconds = start.elapsed().as_secs_f64();
     Ok(timing)
 }
+
+/// The walk of incoherent rays through the hierarchy alone, for `cargo bench`: the
+/// mirror reflections of the primary hits of a scene's view (every `stride`-th pixel
+/// each way), spawned as the tracer spawns them and queried for their closest hits
+/// with no shading around them. In a large scene this walk is most of a render.
+pub struct SecondaryWalk {
+    spheres: crate::accel::Spheres,
+    rays: Vec<crate::accel::Query>,
+}
+
+impl SecondaryWalk {
+    /// The rays of `scene`'s camera at `width`×`height`, every `stride`-th pixel.
+    pub fn new(scene: &Scene, width: u32, height: u32, stride: u32) -> Result<Self, RenderError> {
+        use crate::accel::{Query, Spheres};
+        use crate::model::Side;
+        let camera = scene.camera(width, height)?;
+        let spheres = Spheres::new(&scene.spheres);
+        let mut rays = Vec::new();
+        for y in (0..height).step_by(stride.max(1) as usize) {
+            for x in (0..width).step_by(stride.max(1) as usize) {
+                let (s, t) = (
+                    (f64::from(x) + 0.5) / f64::from(width),
+                    (f64::from(y) + 0.5) / f64::from(height),
+                );
+                let dir = (camera.lower_left + camera.horizontal * s + camera.vertical * t
+                    - camera.origin)
+                    .normalize()
+                    .as_vec3();
+                let primary = Query {
+                    origin: camera.origin,
+                    dir,
+                    from: None,
+                };
+                if let Some(hit) = spheres.closest(&primary) {
+                    let n = hit.normal.as_vec3();
+                    rays.push(Query {
+                        origin: hit.point,
+                        dir: crate::model::reflect(dir, n).normalize(),
+                        from: Some((hit.sphere, Side::inside(!hit.entering))),
+                    });
+                }
+            }
+        }
+        Ok(SecondaryWalk { spheres, rays })
+    }
+
+    /// The rays walked by [`SecondaryWalk::closest_hits`].
+    pub fn len(&self) -> usize {
+        self.rays.len()
+    }
+
+    /// Whether there are no rays (a view of sky only).
+    pub fn is_empty(&self) -> bool {
+        self.rays.is_empty()
+    }
+
+    /// Walks every ray to its closest hit, on this thread; returns how many hit.
+    pub fn closest_hits(&self) -> usize {
+        self.rays
+            .iter()
+            .filter(|q| self.spheres.closest(q).is_some())
+            .count()
+    }
+}

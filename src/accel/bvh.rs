@@ -35,6 +35,14 @@ impl Aabb {
     }
 }
 
+/// An item as the build moves it: its box, the box's centre and its index.
+#[derive(Clone, Copy)]
+struct BuildItem {
+    bounds: Aabb,
+    centre: Vec3,
+    index: u32,
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Node {
     bounds: Aabb,
@@ -85,11 +93,20 @@ const STACK: usize = 320;
 impl Bvh {
     /// Builds over `boxes` (one per item): a binary binned-SAH tree, then collapsed.
     pub(super) fn build(boxes: &[Aabb]) -> Bvh {
-        let mut items: Vec<u32> = (0..boxes.len() as u32).collect();
-        let centres: Vec<Vec3> = boxes.iter().map(Aabb::centre).collect();
+        // Each item's box and centre travel with it as the splits reorder the items,
+        // so every level of the build reads them in order, not from all over `boxes`.
+        let mut items: Vec<BuildItem> = boxes
+            .iter()
+            .enumerate()
+            .map(|(k, b)| BuildItem {
+                bounds: *b,
+                centre: b.centre(),
+                index: k as u32,
+            })
+            .collect();
         let mut binary = Vec::with_capacity(2 * boxes.len().max(1));
         if !boxes.is_empty() {
-            build_node(boxes, &centres, &mut items, 0, 0, &mut binary);
+            build_node(&mut items, 0, 0, &mut binary);
         }
         let mut nodes = Vec::with_capacity(binary.len() / 2 + 1);
         if let Some(root) = binary.first() {
@@ -100,6 +117,7 @@ impl Bvh {
                 collapse(&binary, 0, &mut nodes);
             }
         }
+        let items = items.iter().map(|item| item.index).collect();
         Bvh { nodes, items }
     }
 
@@ -306,19 +324,12 @@ fn node4(binary: &[Node], children: &[usize]) -> Node4 {
     }
 }
 
-fn build_node(
-    boxes: &[Aabb],
-    centres: &[Vec3],
-    items: &mut [u32],
-    first: u32,
-    depth: u32,
-    nodes: &mut Vec<Node>,
-) -> u32 {
+fn build_node(items: &mut [BuildItem], first: u32, depth: u32, nodes: &mut Vec<Node>) -> u32 {
     let mut bounds = Aabb::EMPTY;
     let mut centre_bounds = Aabb::EMPTY;
-    for &i in items.iter() {
-        bounds.grow(&boxes[i as usize]);
-        let c = centres[i as usize];
+    for item in items.iter() {
+        bounds.grow(&item.bounds);
+        let c = item.centre;
         centre_bounds.grow(&Aabb { min: c, max: c });
     }
     let me = nodes.len() as u32;
@@ -332,7 +343,7 @@ fn build_node(
         return me;
     }
     let sah = if depth < MAX_SAH_DEPTH {
-        best_split(boxes, centres, items, &centre_bounds, &bounds)
+        best_split(items, &centre_bounds, &bounds)
     } else {
         None
     };
@@ -347,12 +358,10 @@ fn build_node(
     let Some((axis, split)) = split else {
         return me; // no split beats a leaf
     };
-    let mid = partition(items, |i| centres[i as usize][axis] < split);
+    let mid = partition(items, |item| item.centre[axis] < split);
     // Degenerate partitions (all centres equal on the axis) split by count.
     let mid = if mid == 0 || mid == items.len() {
-        items.sort_unstable_by(|&a, &b| {
-            centres[a as usize][axis].total_cmp(&centres[b as usize][axis])
-        });
+        items.sort_unstable_by(|a, b| a.centre[axis].total_cmp(&b.centre[axis]));
         items.len() / 2
     } else {
         mid
@@ -362,8 +371,8 @@ fn build_node(
         // Big subtrees build on two threads, into their own vectors, then splice.
         let (mut l, mut r) = (Vec::new(), Vec::new());
         rayon::join(
-            || build_node(boxes, centres, left, first, depth + 1, &mut l),
-            || build_node(boxes, centres, right, first + mid as u32, depth + 1, &mut r),
+            || build_node(left, first, depth + 1, &mut l),
+            || build_node(right, first + mid as u32, depth + 1, &mut r),
         );
         let base = nodes.len() as u32;
         nodes.extend(l.into_iter().map(|n| offset(n, base)));
@@ -371,8 +380,8 @@ fn build_node(
         nodes.extend(r.into_iter().map(|n| offset(n, right_base)));
         right_base
     } else {
-        build_node(boxes, centres, left, first, depth + 1, nodes);
-        build_node(boxes, centres, right, first + mid as u32, depth + 1, nodes)
+        build_node(left, first, depth + 1, nodes);
+        build_node(right, first + mid as u32, depth + 1, nodes)
     };
     nodes[me as usize].index = right_index;
     nodes[me as usize].count = 0;
@@ -394,13 +403,7 @@ fn offset(mut n: Node, base: u32) -> Node {
 }
 
 /// The binned-SAH split `(axis, position)`, or `None` when a leaf is cheaper.
-fn best_split(
-    boxes: &[Aabb],
-    centres: &[Vec3],
-    items: &[u32],
-    centre_bounds: &Aabb,
-    bounds: &Aabb,
-) -> Option<(usize, f32)> {
+fn best_split(items: &[BuildItem], centre_bounds: &Aabb, bounds: &Aabb) -> Option<(usize, f32)> {
     let mut best: Option<(f32, usize, f32)> = None;
     // Bin along the axis where the centres spread most (a third of the work of trying
     // all three, for trees nearly as good).
@@ -414,9 +417,9 @@ fn best_split(
         let scale = BINS as f32 / (hi - lo);
         let mut bin_bounds = [Aabb::EMPTY; BINS];
         let mut bin_count = [0u32; BINS];
-        for &i in items {
-            let b = (((centres[i as usize][axis] - lo) * scale) as usize).min(BINS - 1);
-            bin_bounds[b].grow(&boxes[i as usize]);
+        for item in items {
+            let b = (((item.centre[axis] - lo) * scale) as usize).min(BINS - 1);
+            bin_bounds[b].grow(&item.bounds);
             bin_count[b] += 1;
         }
         // Sweep from the right, then from the left, evaluating the cost of each plane.
@@ -451,10 +454,10 @@ fn best_split(
 }
 
 /// Moves the items for which `left` holds to the front; returns how many there are.
-fn partition(items: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
+fn partition(items: &mut [BuildItem], left: impl Fn(&BuildItem) -> bool) -> usize {
     let mut mid = 0;
     for k in 0..items.len() {
-        if left(items[k]) {
+        if left(&items[k]) {
             items.swap(k, mid);
             mid += 1;
         }

@@ -156,12 +156,12 @@ impl Spheres {
         let center: Vec<DVec3> = spheres.iter().map(|s| s.center).collect();
         let radius: Vec<f64> = spheres.iter().map(|s| s.radius).collect();
         let quick: Vec<Vec4> = center
-            .iter()
+            .par_iter()
             .zip(&radius)
             .map(|(&c, &r)| quick_sphere(c, r))
             .collect();
         let boxes: Vec<Aabb> = center
-            .iter()
+            .par_iter()
             .zip(&radius)
             .map(|(&c, &r)| {
                 let widen = r * 1e-6 + 1e-6 * c.abs().max_element();
@@ -193,7 +193,7 @@ impl Spheres {
         let inside = (0..spheres.len()).map(|_| OnceLock::new()).collect();
         let leaf = bvh
             .items()
-            .iter()
+            .par_iter()
             .map(|&k| LeafSphere {
                 exact: Exact {
                     center: center[k as usize],

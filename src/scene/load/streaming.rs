@@ -29,14 +29,7 @@ impl SphereRun {
         let mut first = None;
         let mut count = 0usize;
         let mut other_table_after = false;
-        let mut offset = 0;
-        for line in text.split_inclusive('\n') {
-            let start = offset;
-            offset += line.len();
-            let trimmed = line.trim_start();
-            if !trimmed.starts_with('[') {
-                continue;
-            }
+        for (start, trimmed) in table_lines(text) {
             if is_sphere_header(trimmed) {
                 count += 1;
                 if count > limits::MAX_SPHERES {
@@ -54,7 +47,9 @@ impl SphereRun {
                 other_table_after = true;
             }
         }
-        let multi_line_strings = text.contains("\"\"\"") || text.contains("'''");
+        let bytes = text.as_bytes();
+        let multi_line_strings = memchr::memmem::find(bytes, b"\"\"\"").is_some()
+            || memchr::memmem::find(bytes, b"'''").is_some();
         Ok(match first {
             Some(first) if !other_table_after && !multi_line_strings => {
                 Some(SphereRun { first, count })
@@ -65,14 +60,10 @@ impl SphereRun {
 
     /// The byte ranges of the tables of the run, in order.
     fn tables<'t>(&self, text: &'t str) -> impl Iterator<Item = Range<usize>> + 't {
-        let mut starts = text[self.first..]
-            .split_inclusive('\n')
-            .scan(self.first, |offset, line| {
-                let start = *offset;
-                *offset += line.len();
-                Some((start, line))
-            })
-            .filter(|(_, line)| is_sphere_header(line.trim_start()))
+        let first = self.first;
+        let mut starts = table_lines(&text[first..])
+            .map(move |(start, trimmed)| (first + start, trimmed))
+            .filter(|&(_, trimmed)| is_sphere_header(trimmed))
             .map(|(start, _)| start)
             .peekable();
         std::iter::from_fn(move || {
@@ -81,6 +72,33 @@ impl SphereRun {
             Some(start..end)
         })
     }
+}
+
+/// The lines whose first non-blank character is `[` (`trim_start`'s blanks): each
+/// line's start, and the line from that `[` to its end. Found from the `[`s of the
+/// text (a vectorised search), not line by line: a scene file has a few a table, and
+/// many short lines. Each byte is looked at a bounded number of times, however long
+/// the lines and however many `[`s they hold.
+fn table_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let bytes = text.as_bytes();
+    let (mut line_start, mut scanned, mut line_seen) = (0, 0, false);
+    memchr::memchr_iter(b'[', bytes).filter_map(move |at| {
+        if let Some(n) = memchr::memrchr(b'\n', &bytes[scanned..at]) {
+            (line_start, line_seen) = (scanned + n + 1, false);
+        }
+        scanned = at;
+        // Only a line's first `[` can be its first non-blank character.
+        if std::mem::replace(&mut line_seen, true) {
+            return None;
+        }
+        text[line_start..at]
+            .chars()
+            .all(char::is_whitespace)
+            .then(|| {
+                let end = memchr::memchr(b'\n', &bytes[at..]).map_or(text.len(), |n| at + n + 1);
+                (line_start, &text[at..end])
+            })
+    })
 }
 
 /// `[[sphere]]`, spaces allowed inside the brackets, then nothing or a comment.
