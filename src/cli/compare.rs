@@ -57,7 +57,11 @@ fn load(path: &Path) -> anyhow::Result<Levels> {
         .map_err(anyhow::Error::from)
         .and_then(|file| {
             let hint = image::ImageFormat::from_path(path).ok();
-            Ok(image_io::decode_image(BufReader::new(file), hint)?)
+            Ok(image_io::decode_image(
+                BufReader::new(file),
+                hint,
+                image::Limits::default(),
+            )?)
         })
         .with_context(|| format!("{}: cannot read the image", path.display()))?;
     Ok(Levels::from_image(image))

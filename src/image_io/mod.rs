@@ -190,16 +190,18 @@ pub struct SaveError {
 }
 
 /// Decodes an image file read from `reader` (what `whitted compare` reads): its format
-/// from its first bytes, else `format`, within `image`'s default limits on size and
-/// memory.
+/// from its first bytes, else `format`, within `limits` on size and memory
+/// (`image::Limits::default()` for files, smaller ones to fuzz faster).
 pub fn decode_image<R: BufRead + Seek>(
     reader: R,
     format: Option<image::ImageFormat>,
+    limits: image::Limits,
 ) -> image::ImageResult<DynamicImage> {
     let mut reader = image::ImageReader::new(reader);
     if let Some(format) = format {
         reader.set_format(format);
     }
+    reader.limits(limits);
     reader.with_guessed_format()?.decode()
 }
 
