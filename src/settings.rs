@@ -13,7 +13,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use crate::limits::{MAX_DEPTH, MAX_PIXELS, MAX_SIDE, MAX_SPP};
+use crate::limits::{MAX_DEPTH, MAX_FRAMES, MAX_PIXELS, MAX_SIDE, MAX_SPP};
 
 /// Which implementation of the model renders (SPEC §2: both compute the same function).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -280,6 +280,36 @@ impl Region {
     }
 }
 
+/// Text that is not a [`Region`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("expected X,Y,W,H: four whole numbers, W and H at least 1")]
+pub struct BadRegion;
+
+impl FromStr for Region {
+    type Err = BadRegion;
+
+    /// `X,Y,W,H` (the command line's `--region`), spaces allowed around the numbers.
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        let numbers: Result<Vec<u32>, _> = text.split(',').map(|p| p.trim().parse()).collect();
+        match numbers.as_deref() {
+            Ok(&[x, y, width, height]) if width > 0 && height > 0 => Ok(Region {
+                x,
+                y,
+                width,
+                height,
+            }),
+            _ => Err(BadRegion),
+        }
+    }
+}
+
+impl fmt::Display for Region {
+    /// `X,Y,W,H`, as [`Region::from_str`] reads it.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{},{},{},{}", self.x, self.y, self.width, self.height)
+    }
+}
+
 /// Tile `index` (from 0) of a grid of `count` tiles over the image: a part of the image
 /// for one machine of many (SPEC §5). The grid is the program's choice
 /// ([`Tile::grid`]); a tile is a rectangle, and the tiles cover the image once.
@@ -327,6 +357,98 @@ impl Tile {
             width: x1 - x0,
             height: y1 - y0,
         })
+    }
+}
+
+/// Text that is not a [`Tile`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("expected I/N: tile I of N tiles, 0 <= I < N")]
+pub struct BadTile;
+
+impl FromStr for Tile {
+    type Err = BadTile;
+
+    /// `I/N` (the command line's `--tile`), spaces allowed around the numbers.
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        let (index, count) = text.split_once('/').ok_or(BadTile)?;
+        match (index.trim().parse(), count.trim().parse()) {
+            (Ok(index), Ok(count)) if index < count => Ok(Tile { index, count }),
+            _ => Err(BadTile),
+        }
+    }
+}
+
+impl fmt::Display for Tile {
+    /// `I/N`, as [`Tile::from_str`] reads it.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// Frames `start..end` (end excluded, `start < end <= MAX_FRAMES`) of an animation,
+/// numbered as in the whole sequence.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FrameRange {
+    /// The first frame.
+    pub start: u32,
+    /// The frame after the last.
+    pub end: u32,
+}
+
+impl FrameRange {
+    /// All `frames` frames of a sequence.
+    pub fn all(frames: u32) -> FrameRange {
+        FrameRange {
+            start: 0,
+            end: frames,
+        }
+    }
+
+    /// Frames in the range.
+    pub fn len(&self) -> u32 {
+        self.end.saturating_sub(self.start)
+    }
+
+    /// Whether the range holds no frame (never, for a parsed range).
+    pub fn is_empty(&self) -> bool {
+        self.end <= self.start
+    }
+}
+
+/// Text that is not a [`FrameRange`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("expected a frame number K or a range A..B with A < B (frames from 0 to {MAX_FRAMES})")]
+pub struct BadFrameRange;
+
+impl FromStr for FrameRange {
+    type Err = BadFrameRange;
+
+    /// `K` (frame K alone) or `A..B` (the command line's `--frame`), spaces allowed
+    /// around the numbers. B may be [`MAX_FRAMES`]: the range of a sequence's last
+    /// frames.
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        let number = |s: &str| s.trim().parse::<u32>().ok().filter(|&k| k <= MAX_FRAMES);
+        let (start, end) = match text.split_once("..") {
+            None => number(text).map(|k| (k, k.saturating_add(1))),
+            Some((a, b)) => number(a).zip(number(b)),
+        }
+        .ok_or(BadFrameRange)?;
+        if start < end && end <= MAX_FRAMES {
+            Ok(FrameRange { start, end })
+        } else {
+            Err(BadFrameRange)
+        }
+    }
+}
+
+impl fmt::Display for FrameRange {
+    /// `K` for one frame, else `A..B`, as [`FrameRange::from_str`] reads it.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.len() == 1 {
+            write!(f, "{}", self.start)
+        } else {
+            write!(f, "{}..{}", self.start, self.end)
+        }
     }
 }
 
@@ -693,6 +815,77 @@ mod tests {
                     }
                 },
             )
+    }
+
+    #[test]
+    fn regions_read_four_numbers_and_print_back() {
+        let r: Region = " 3, 4,5 ,6".parse().unwrap();
+        assert_eq!(
+            r,
+            Region {
+                x: 3,
+                y: 4,
+                width: 5,
+                height: 6
+            }
+        );
+        assert_eq!(r.to_string(), "3,4,5,6");
+        for bad in ["1,2,0,4", "1,2,3", "1,2,3,4,5", "-1,2,3,4", "a,b,c,d", ""] {
+            assert_eq!(bad.parse::<Region>(), Err(BadRegion), "{bad}");
+        }
+        assert_eq!(
+            BadRegion.to_string(),
+            "expected X,Y,W,H: four whole numbers, W and H at least 1"
+        );
+    }
+
+    #[test]
+    fn tiles_need_an_index_below_the_count() {
+        assert_eq!("2 / 7".parse(), Ok(Tile { index: 2, count: 7 }));
+        assert_eq!(Tile { index: 2, count: 7 }.to_string(), "2/7");
+        for bad in ["4/4", "0/0", "a/b", "3", "1/2/3", "-1/2"] {
+            assert_eq!(bad.parse::<Tile>(), Err(BadTile), "{bad}");
+        }
+        assert_eq!(
+            BadTile.to_string(),
+            "expected I/N: tile I of N tiles, 0 <= I < N"
+        );
+    }
+
+    #[test]
+    fn frame_ranges_exclude_their_end() {
+        assert_eq!("5".parse(), Ok(FrameRange { start: 5, end: 6 }));
+        assert_eq!("2..9".parse(), Ok(FrameRange { start: 2, end: 9 }));
+        assert_eq!(FrameRange { start: 5, end: 6 }.to_string(), "5");
+        assert_eq!(FrameRange { start: 2, end: 9 }.to_string(), "2..9");
+        // The last frame of the longest sequence, alone or ending a range.
+        let last = MAX_FRAMES - 1;
+        assert_eq!(
+            last.to_string().parse(),
+            Ok(FrameRange {
+                start: last,
+                end: MAX_FRAMES
+            })
+        );
+        assert_eq!(
+            format!("0..{MAX_FRAMES}").parse(),
+            Ok(FrameRange::all(MAX_FRAMES))
+        );
+        let beyond = [
+            MAX_FRAMES.to_string(),
+            format!("0..{}", MAX_FRAMES + 1),
+            u32::MAX.to_string(),
+        ];
+        for bad in ["9..2", "3..3", "-1", "a", "1..", "..4", "1..2..3"]
+            .into_iter()
+            .chain(beyond.iter().map(String::as_str))
+        {
+            assert_eq!(bad.parse::<FrameRange>(), Err(BadFrameRange), "{bad}");
+        }
+        assert_eq!(
+            BadFrameRange.to_string(),
+            "expected a frame number K or a range A..B with A < B (frames from 0 to 1048576)"
+        );
     }
 
     proptest! {

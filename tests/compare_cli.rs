@@ -196,3 +196,28 @@ fn the_heat_map_is_dark_where_equal_and_bright_where_different() {
     let o = compare(&[&a, &b], &["--heatmap", "heat.exr"]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// An EXR pixel that is NaN counts as 0, as every 8-bit file shows it: it used to make
+/// the RMSE NaN, which passed any --max-rmse (found by the `image` fuzz target).
+#[test]
+fn a_nan_pixel_counts_as_black() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut linear = Rgb32FImage::from_pixel(4, 3, Rgb([0.0, 0.0, 0.0]));
+    linear.put_pixel(1, 2, Rgb([f32::NAN, 0.0, 0.0]));
+    let nan = dir.path().join("nan.exr");
+    linear.save(&nan).unwrap();
+    let black = save(dir.path(), "black.png", &RgbImage::new(4, 3));
+    let o = compare(&[&nan, &black], &["--max-rmse", "0"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(field(&stdout(&o), "rmse"), "0.0000");
+
+    // Against white, every channel of every pixel is 255 levels off: the NaN too.
+    let white = save(
+        dir.path(),
+        "white.png",
+        &RgbImage::from_pixel(4, 3, Rgb([255, 255, 255])),
+    );
+    let o = compare(&[&nan, &white], &["--max-rmse", "254"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+    assert_eq!(field(&stdout(&o), "rmse"), "255.0000");
+}

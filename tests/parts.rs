@@ -249,3 +249,53 @@ fn bad_tiles_are_usage_errors() {
         "does not exist in a 2x3 image",
     );
 }
+
+/// A 1×1 8-bit RGB PNG whose `whitted-part` text is `record`.
+fn png_with_record(record: &str) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut encoder = png::Encoder::new(&mut out, 1, 1);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder
+        .add_text_chunk("whitted-part".into(), record.into())
+        .unwrap();
+    let mut writer = encoder.write_header().unwrap();
+    writer.write_image_data(&[10, 20, 30]).unwrap();
+    writer.finish().unwrap();
+    out
+}
+
+/// A record of a whole image larger than a render can make is refused: `stitch`
+/// allocates the whole image its parts name, and 4000000000x4000000000 pixels panicked
+/// (capacity overflow), 100000x100000 aborted (40 GB) (found by reading `stitch` for
+/// the `part` fuzz target).
+#[test]
+fn a_record_of_an_image_no_render_makes_is_refused() {
+    use whitted::image_io::parts::{BadPlacement, Placement};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = path(d, "out.png");
+    for (k, image) in [
+        "4000000000x4000000000",
+        "100000x100000",
+        "65537x1",
+        "16385x16385",
+        "0x1",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let record = format!("region=0,0,1,1 image={image} id=0");
+        assert_eq!(record.parse::<Placement>(), Err(BadPlacement), "{record}");
+        let part = path(d, &format!("p{k}.png"));
+        std::fs::write(&part, png_with_record(&record)).unwrap();
+        fails(&["stitch", "-o", &out, &part], 1, "records no place");
+        assert!(!Path::new(&out).exists());
+    }
+    // The largest images a render makes: 65536 wide, or 16384x16384.
+    for image in ["65536x4096", "16384x16384", "1x65536"] {
+        let record = format!("region=0,0,1,1 image={image} id=0");
+        let p: Placement = record.parse().unwrap();
+        assert_eq!(p.to_string().parse(), Ok(p));
+    }
+}

@@ -55,10 +55,13 @@ impl Levels {
         );
         if float {
             let linear = image.into_rgb32f();
+            // NaN counts as 0, as `to_byte` shows it: `max` drops a NaN, `clamp` would
+            // keep it and make every error NaN, which no threshold catches.
+            #[allow(clippy::manual_clamp)]
             let values = linear
                 .as_raw()
                 .iter()
-                .map(|&c| f64::from(c.clamp(0.0, 1.0)) * 255.0)
+                .map(|&c| f64::from(c.max(0.0).min(1.0)) * 255.0)
                 .collect();
             let bytes = linear.as_raw().iter().map(|&c| to_byte(c)).collect();
             Levels {

@@ -27,7 +27,7 @@ use whitted::image_io::{self, AnimatedFormat, AnimatedWriter, Format};
 use whitted::limits::MAX_FRAMES;
 use whitted::render::{Frame, RenderControl, RenderError, Sequence};
 use whitted::scene::Scene;
-use whitted::settings::{Encoding, Settings};
+use whitted::settings::{Encoding, FrameRange, Settings};
 
 /// The animation options of `whitted render`.
 #[derive(Args, Clone, Debug, Default)]
@@ -41,15 +41,8 @@ pub(crate) struct FrameOptions {
     orbit: Option<f64>,
     /// Render only frame K, or frames A to B (B excluded), numbered as in the whole
     /// sequence: each frame is the same bytes either way.
-    #[arg(long, value_name = "K|A..B", value_parser = parse_frame_range)]
+    #[arg(long, value_name = "K|A..B")]
     frame: Option<FrameRange>,
-}
-
-/// Frames `start..end` of a sequence.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct FrameRange {
-    start: u32,
-    end: u32,
 }
 
 fn parse_degrees(text: &str) -> Result<f64, String> {
@@ -57,26 +50,6 @@ fn parse_degrees(text: &str) -> Result<f64, String> {
         Ok(x) if x.is_finite() => Ok(x),
         _ => Err("expected a finite number of degrees".into()),
     }
-}
-
-/// `K` or `A..B` (end excluded, `A < B`).
-fn parse_frame_range(text: &str) -> Result<FrameRange, String> {
-    let number = |s: &str| s.trim().parse::<u32>().ok().filter(|&k| k < MAX_FRAMES);
-    let range = match text.split_once("..") {
-        None => number(text).map(|k| FrameRange {
-            start: k,
-            end: k + 1,
-        }),
-        Some((a, b)) => match (number(a), number(b)) {
-            (Some(start), Some(end)) if start < end => Some(FrameRange { start, end }),
-            _ => None,
-        },
-    };
-    range.ok_or_else(|| {
-        format!(
-            "expected a frame number K or a range A..B with A < B (frames from 0 to {MAX_FRAMES})"
-        )
-    })
 }
 
 /// A file name with `%0Nd` (or `%d`) in it: one file per frame.
@@ -191,23 +164,15 @@ pub(crate) fn render_frames(
     }
     let frames = scene.frames();
     let fps = scene.fps();
-    let range = options.frame.unwrap_or(FrameRange {
-        start: 0,
-        end: frames,
-    });
+    let range = options.frame.unwrap_or(FrameRange::all(frames));
     if range.end > frames {
         return Err(usage(format!(
-            "--frame {}: the scene has {frames} frame{} (0 to {})",
-            if range.end == range.start + 1 {
-                range.start.to_string()
-            } else {
-                format!("{}..{}", range.start, range.end)
-            },
+            "--frame {range}: the scene has {frames} frame{} (0 to {})",
             if frames == 1 { "" } else { "s" },
             frames - 1
         )));
     }
-    let count = range.end - range.start;
+    let count = range.len();
     let defaults = [PathBuf::from("output.ppm"), PathBuf::from("output.png")];
     let outputs = if outputs.is_empty() && count == 1 {
         &defaults[..]
@@ -433,17 +398,5 @@ mod tests {
         assert_eq!(p.path(3), PathBuf::from("100%-3.ppm"));
         assert_eq!(Pattern::find("plain.png"), None);
         assert_eq!(Pattern::find("f-%4d.png"), None, "no zero: not a pattern");
-    }
-
-    #[test]
-    fn frame_ranges_exclude_their_end() {
-        assert_eq!(parse_frame_range("5"), Ok(FrameRange { start: 5, end: 6 }));
-        assert_eq!(
-            parse_frame_range("2..9"),
-            Ok(FrameRange { start: 2, end: 9 })
-        );
-        for bad in ["9..2", "3..3", "-1", "a", "1..", "..4"] {
-            assert!(parse_frame_range(bad).is_err(), "{bad}");
-        }
     }
 }

@@ -2,6 +2,7 @@
 //! (`rmse=… psnr=… max=… over1=…% flip=…`, 8-bit levels), a heat map on request, and
 //! exit status 1 past a threshold, for scripts and CI.
 
+use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
@@ -52,10 +53,16 @@ fn parse_heat_map(text: &str) -> Result<HeatMap, String> {
 }
 
 fn load(path: &Path) -> anyhow::Result<Levels> {
-    let image = image::ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
+    let image = std::fs::File::open(path)
         .map_err(anyhow::Error::from)
-        .and_then(|r| Ok(r.decode()?))
+        .and_then(|file| {
+            let hint = image::ImageFormat::from_path(path).ok();
+            Ok(image_io::decode_image(
+                BufReader::new(file),
+                hint,
+                image::Limits::default(),
+            )?)
+        })
         .with_context(|| format!("{}: cannot read the image", path.display()))?;
     Ok(Levels::from_image(image))
 }

@@ -50,12 +50,12 @@ pub(crate) struct RenderArgs {
     #[arg(long, allow_negative_numbers = true, value_parser = whole_number(1, 1024))]
     threads: Option<u32>,
     /// Render only this rectangle: X,Y,W,H in output pixels, origin top-left.
-    #[arg(long, value_name = "X,Y,W,H", value_parser = parse_region)]
+    #[arg(long, value_name = "X,Y,W,H")]
     region: Option<Region>,
     /// Render only tile I (from 0) of a grid of N tiles the program picks (near-square
     /// rectangles, row by row). PNG and EXR parts record their place for
     /// `whitted stitch`.
-    #[arg(long, value_name = "I/N", value_parser = parse_tile, conflicts_with = "region")]
+    #[arg(long, value_name = "I/N", conflicts_with = "region")]
     tile: Option<Tile>,
     /// Use the slow f64 reference renderer.
     #[arg(long)]
@@ -91,30 +91,6 @@ impl RenderArgs {
             threads: self.threads.map(|t| t as usize),
             encoding: self.encoding,
         }
-    }
-}
-
-fn parse_tile(text: &str) -> Result<Tile, String> {
-    let parsed = text
-        .split_once('/')
-        .and_then(|(i, n)| Some((i.trim().parse::<u32>().ok()?, n.trim().parse::<u32>().ok()?)));
-    match parsed {
-        Some((index, count)) if index < count => Ok(Tile { index, count }),
-        _ => Err("expected I/N: tile I of N tiles, 0 <= I < N".into()),
-    }
-}
-
-fn parse_region(text: &str) -> Result<Region, String> {
-    let parts: Vec<&str> = text.split(',').collect();
-    let numbers: Result<Vec<u32>, _> = parts.iter().map(|p| p.trim().parse::<u32>()).collect();
-    match numbers.as_deref() {
-        Ok(&[x, y, width, height]) if width > 0 && height > 0 => Ok(Region {
-            x,
-            y,
-            width,
-            height,
-        }),
-        _ => Err("expected X,Y,W,H: four whole numbers, W and H at least 1".into()),
     }
 }
 

@@ -6,14 +6,14 @@
 
 mod animated;
 
-use std::io::{Cursor, Write};
+use std::io::{BufRead, Cursor, Seek, Write};
 use std::path::{Path, PathBuf};
 
 use image::codecs::bmp::BmpEncoder;
 use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
 use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
-use image::{ExtendedColorType, ImageEncoder, Rgb32FImage, RgbImage};
+use image::{DynamicImage, ExtendedColorType, ImageEncoder, Rgb32FImage, RgbImage};
 use rayon::prelude::*;
 
 use crate::render::Frame;
@@ -187,6 +187,22 @@ pub struct SaveError {
     pub path: String,
     /// What went wrong.
     pub message: String,
+}
+
+/// Decodes an image file read from `reader` (what `whitted compare` reads): its format
+/// from its first bytes, else `format`, within `limits` on size and memory
+/// (`image::Limits::default()` for files, smaller ones to fuzz faster).
+pub fn decode_image<R: BufRead + Seek>(
+    reader: R,
+    format: Option<image::ImageFormat>,
+    limits: image::Limits,
+) -> image::ImageResult<DynamicImage> {
+    let mut reader = image::ImageReader::new(reader);
+    if let Some(format) = format {
+        reader.set_format(format);
+    }
+    reader.limits(limits);
+    reader.with_guessed_format()?.decode()
 }
 
 /// Encodes 8-bit RGB (top row first) in `format`.
@@ -373,7 +389,7 @@ pub(crate) fn exr_bytes(
         attributes.layer_position = Vec2(p.region.x as i32, p.region.y as i32);
         attributes.other.insert(
             Text::from(parts::KEY),
-            AttributeValue::Text(Text::from(p.to_text().as_str())),
+            AttributeValue::Text(Text::from(p.to_string().as_str())),
         );
     }
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {

@@ -6,12 +6,16 @@
 //! the standard data window (the part's pixels) inside the display window (the whole
 //! image), with the same text as a header attribute. Other formats cannot carry it.
 
+use std::fmt;
+use std::io::{BufRead, Seek};
 use std::path::Path;
+use std::str::FromStr;
 
 use glam::Vec3;
 use image::{Rgb32FImage, RgbImage};
 
 use super::{exr_bytes, to_rgb32f, to_rgb8, write_atomically, Format, SaveError};
+use crate::limits;
 use crate::render::Frame;
 use crate::scene::{to_toml, Scene};
 use crate::settings::{Encoding, Region, Settings};
@@ -46,64 +50,76 @@ impl Placement {
             encoding: settings.encoding,
         }
     }
+}
 
-    pub(super) fn to_text(self) -> String {
-        let r = self.region;
-        format!(
-            "region={},{},{},{} image={}x{} id={:016x} encoding={}",
-            r.x,
-            r.y,
-            r.width,
-            r.height,
+impl fmt::Display for Placement {
+    /// The record's text: `region=X,Y,W,H image=WxH id=HEX encoding=NAME`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "region={} image={}x{} id={:016x} encoding={}",
+            self.region,
             self.width,
             self.height,
             self.image,
             self.encoding.name()
         )
     }
+}
 
-    fn from_text(text: &str) -> Option<Placement> {
-        let mut region = None;
-        let mut size = None;
-        let mut id = None;
-        let mut encoding = Encoding::Linear;
-        for field in text.split_whitespace() {
-            let (key, value) = field.split_once('=')?;
-            match key {
-                "region" => {
-                    let n: Vec<u32> = value
-                        .split(',')
-                        .map(str::parse)
-                        .collect::<Result<_, _>>()
-                        .ok()?;
-                    if let [x, y, width, height] = n[..] {
-                        region = Some(Region {
-                            x,
-                            y,
-                            width,
-                            height,
-                        });
-                    }
-                }
-                "image" => {
-                    let (w, h) = value.split_once('x')?;
-                    size = Some((w.parse().ok()?, h.parse().ok()?));
-                }
-                "id" => id = Some(u64::from_str_radix(value, 16).ok()?),
-                "encoding" => encoding = value.parse().ok()?,
-                _ => {}
-            }
+/// A record that is not a [`Placement`], or places a part outside the image, or
+/// describes an image larger than a render can be.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("not a part's record")]
+pub struct BadPlacement;
+
+impl FromStr for Placement {
+    type Err = BadPlacement;
+
+    /// The record's text as [`Placement`]'s `Display` writes it; fields in any order,
+    /// unknown fields ignored, `encoding` linear when missing.
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        let placement = record(text).ok_or(BadPlacement)?;
+        let (width, height) = (placement.width, placement.height);
+        // The whole image is one `whitted render` could make: `stitch` allocates it.
+        let whole_fits = (1..=limits::MAX_SIDE).contains(&width)
+            && (1..=limits::MAX_SIDE).contains(&height)
+            && u64::from(width) * u64::from(height) <= limits::MAX_PIXELS;
+        if whole_fits && placement.region.fits_in(width, height) {
+            Ok(placement)
+        } else {
+            Err(BadPlacement)
         }
-        let (width, height) = size?;
-        let placement = Placement {
-            region: region?,
-            width,
-            height,
-            image: id?,
-            encoding,
-        };
-        placement.region.fits_in(width, height).then_some(placement)
     }
+}
+
+/// The fields of a record, not yet checked against each other.
+fn record(text: &str) -> Option<Placement> {
+    let mut region = None;
+    let mut size = None;
+    let mut id = None;
+    let mut encoding = Encoding::Linear;
+    for field in text.split_whitespace() {
+        let (key, value) = field.split_once('=')?;
+        match key {
+            "region" => region = Some(value.parse::<Region>().ok()?),
+            "image" => {
+                let (w, h) = value.split_once('x')?;
+                size = Some((w.parse().ok()?, h.parse().ok()?));
+            }
+            "id" => id = Some(u64::from_str_radix(value, 16).ok()?),
+            "encoding" => encoding = value.parse().ok()?,
+            _ => {}
+        }
+    }
+    let (width, height) = size?;
+    Some(Placement {
+        region: region?,
+        width,
+        height,
+        image: id?,
+        encoding,
+    })
 }
 
 /// A fingerprint of the image that `settings` make of `scene`, whatever part of it is
@@ -130,21 +146,26 @@ pub fn save_part(
     format: Format,
     encoding: Encoding,
 ) -> Result<(), SaveError> {
-    let err = |message: String| SaveError {
+    let bytes = encode_part(frame, placement, format, encoding).map_err(|message| SaveError {
         path: path.display().to_string(),
         message,
-    };
-    let bytes = match format {
+    })?;
+    write_atomically(path, &bytes)
+}
+
+/// The bytes of the file [`save_part`] writes.
+pub fn encode_part(
+    frame: &Frame,
+    placement: &Placement,
+    format: Format,
+    encoding: Encoding,
+) -> Result<Vec<u8>, String> {
+    match format {
         Format::Png => png_part(&to_rgb8(frame, encoding), placement),
         Format::Exr => exr_bytes(&to_rgb32f(frame), Some(placement)).map_err(|e| e.to_string()),
-        _ => {
-            return Err(err(
-                "a part records its place in the image only in PNG and EXR files".into(),
-            ))
-        }
+        _ => return Err("a part records its place in the image only in PNG and EXR files".into()),
     }
-    .map_err(|e| err(format!("cannot encode: {e}")))?;
-    write_atomically(path, &bytes)
+    .map_err(|e| format!("cannot encode: {e}"))
 }
 
 fn png_part(image: &RgbImage, placement: &Placement) -> Result<Vec<u8>, String> {
@@ -153,7 +174,7 @@ fn png_part(image: &RgbImage, placement: &Placement) -> Result<Vec<u8>, String> 
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
     encoder
-        .add_text_chunk(KEY.into(), placement.to_text())
+        .add_text_chunk(KEY.into(), placement.to_string())
         .map_err(|e| e.to_string())?;
     let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
     writer
@@ -241,44 +262,67 @@ pub enum StitchError {
     NoParts,
 }
 
-/// Reads a part written by [`save_part`].
+/// Reads a part written by [`save_part`], its kind by the file's extension.
 pub fn read_part(path: &Path) -> Result<Part, StitchError> {
-    let unreadable = |message: String| StitchError::Unreadable {
-        path: path.display().to_string(),
-        message,
-    };
+    let shown = path.display().to_string();
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    match ext.as_str() {
-        "png" => read_png_part(path).map_err(unreadable),
-        "exr" => read_exr_part(path).map_err(unreadable),
-        _ => Err(unreadable(
-            "not a part: parts are PNG or EXR files written with --tile or --region".into(),
-        )),
+    let format = match ext.as_str() {
+        "png" => Format::Png,
+        "exr" => Format::Exr,
+        _ => return Err(unreadable(&shown, not_a_part())),
+    };
+    let file = std::fs::File::open(path).map_err(|e| unreadable(&shown, e.to_string()))?;
+    decode_part(std::io::BufReader::new(file), format, &shown)
+}
+
+/// Reads a part from `reader`: a PNG or EXR file (`format`) written by [`save_part`];
+/// `name` names it in errors.
+pub fn decode_part<R: BufRead + Seek>(
+    reader: R,
+    format: Format,
+    name: &str,
+) -> Result<Part, StitchError> {
+    match format {
+        Format::Png => decode_png_part(reader),
+        Format::Exr => decode_exr_part(reader),
+        _ => Err(not_a_part()),
     }
+    .map_err(|message| unreadable(name, message))
+}
+
+fn unreadable(name: &str, message: String) -> StitchError {
+    StitchError::Unreadable {
+        path: name.to_string(),
+        message,
+    }
+}
+
+fn not_a_part() -> String {
+    "not a part: parts are PNG or EXR files written with --tile or --region".into()
 }
 
 fn no_record() -> String {
     "records no place in an image: not written with --tile or --region".into()
 }
 
-fn read_png_part(path: &Path) -> Result<Part, String> {
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    let decoder = png::Decoder::new(std::io::BufReader::new(file));
+fn decode_png_part<R: BufRead + Seek>(reader: R) -> Result<Part, String> {
+    let decoder = png::Decoder::new(reader);
     let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
     let placement = reader
         .info()
         .uncompressed_latin1_text
         .iter()
         .find(|t| t.keyword == KEY)
-        .and_then(|t| Placement::from_text(&t.text))
+        .and_then(|t| t.text.parse().ok())
         .ok_or_else(no_record)?;
     let info = reader.info();
     if (info.color_type, info.bit_depth) != (png::ColorType::Rgb, png::BitDepth::Eight) {
         return Err("not an 8-bit RGB PNG".into());
     }
+    check_size(&placement, info.width, info.height)?;
     let mut buf = vec![0; reader.output_buffer_size().ok_or("an image too large")?];
     let frame = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
     buf.truncate(frame.buffer_size());
@@ -290,26 +334,49 @@ fn read_png_part(path: &Path) -> Result<Part, String> {
     })
 }
 
-fn read_exr_part(path: &Path) -> Result<Part, String> {
+fn decode_exr_part<R: BufRead + Seek>(mut reader: R) -> Result<Part, String> {
     use exr::meta::attribute::AttributeValue;
-    let image = exr::prelude::read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| Rgb32FImage::new(resolution.width() as u32, resolution.height() as u32),
-        |pixels: &mut Rgb32FImage, p, (r, g, b, _a): (f32, f32, f32, f32)| {
-            pixels.put_pixel(p.x() as u32, p.y() as u32, image::Rgb([r, g, b]))
-        },
-    )
-    .map_err(|e| e.to_string())?;
-    let attributes = &image.layer_data.attributes;
-    let placement = match attributes.other.get(&exr::meta::attribute::Text::from(KEY)) {
-        Some(AttributeValue::Text(t)) => Placement::from_text(&t.to_string()),
+    use exr::meta::MetaData;
+    use exr::prelude::traits::{ReadChannels, ReadLayers};
+    // The headers first: their sizes decide what the pixels take, and a part's are
+    // known from its record before anything that large is allocated.
+    let meta = MetaData::read_from_buffered(&mut reader, false).map_err(|e| e.to_string())?;
+    let header = meta.headers.first().ok_or("an EXR file with no layer")?;
+    let placement = match header
+        .own_attributes
+        .other
+        .get(&exr::meta::attribute::Text::from(KEY))
+    {
+        Some(AttributeValue::Text(t)) => t.to_string().parse().ok(),
         _ => None,
     }
     .ok_or_else(no_record)?;
+    if meta.headers.len() != 1 {
+        return Err("a part holds one layer".into());
+    }
+    let side = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+    let size = header.layer_size;
+    check_size(&placement, side(size.width()), side(size.height()))?;
+    reader.rewind().map_err(|e| e.to_string())?;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |resolution, _| Rgb32FImage::new(resolution.width() as u32, resolution.height() as u32),
+            |pixels: &mut Rgb32FImage, p, (r, g, b, _a): (f32, f32, f32, f32)| {
+                pixels.put_pixel(p.x() as u32, p.y() as u32, image::Rgb([r, g, b]))
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .non_parallel()
+        .from_buffered(reader)
+        .map_err(|e| e.to_string())?;
+    let attributes = &image.layer_data.attributes;
     let pixels = image.layer_data.channel_data.pixels;
     let origin = attributes.layer_position;
     let r = placement.region;
-    if (origin.x(), origin.y()) != (r.x as i32, r.y as i32) {
+    if (i64::from(origin.x()), i64::from(origin.y())) != (i64::from(r.x), i64::from(r.y)) {
         return Err("its data window disagrees with its record".into());
     }
     check_size(&placement, pixels.width(), pixels.height())?;
