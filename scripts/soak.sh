@@ -17,8 +17,10 @@ minutes=${1:-5}
 export SOAK_SECONDS=$(awk -v m="$minutes" 'BEGIN { print m * 60 }')
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
+status=0
 cargo test --release --test viewer_soak -- --ignored --exact soak_for_longer --nocapture \
-    2>&1 | tee "$log"
+    2>&1 | tee "$log" || status=$?
+# The figures of every scene, also when a check failed on one.
 grep '^SOAK ' "$log" | awk '
     {
         for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
@@ -30,4 +32,8 @@ grep '^SOAK ' "$log" | awk '
     END {
         if (NR == 0) { print "FAILED: no SOAK line (the soak did not run)"; exit 1 }
         if (slow != "") { print "FAILED: median answer over 100 ms on" slow; exit 1 }
-    }'
+    }' || status=1
+if [ "$status" -ne 0 ]; then
+    echo "FAILED: a check of the soak failed (see above)" >&2
+    exit "$status"
+fi
