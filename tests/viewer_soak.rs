@@ -40,12 +40,13 @@ const MEMORY_SIZE: (u32, u32) = (640, 360);
 /// Resident memory at the end may differ from the first measurement by this share.
 const MEMORY_TOLERANCE: f64 = 0.10;
 /// glibc's malloc with every block of 4 KiB or more in a mapping of its own, returned
-/// to the system when freed, so that resident memory follows what the viewer holds.
-/// With glibc's defaults it also follows the allocator's history: the threshold
-/// rises to the largest block freed (up to 32 MiB), and the blocks below it are carved
-/// from heaps that fragment. Measured on many_100000 in a 3-minute storm with the
-/// threshold fixed at 128 KiB: 157 -> 214 MiB (anonymous 92 -> 150 MB, the viewer
-/// idle both times); with 4 KiB and the same storm for 2 minutes: 158 -> 161 MiB.
+/// to the system when freed, so that resident memory follows what the viewer holds
+/// more closely. With glibc's defaults it also follows the allocator's history: the
+/// threshold rises to the largest block freed (up to 32 MiB), and the blocks below it
+/// are carved from heaps that fragment. Storms of 2-3 minutes on many_100000 (the
+/// viewer idle at both measurements): at 128 KiB, 157 -> 214 MiB; at 4 KiB, 158 ->
+/// 161 and 156 -> 185 MiB; on hw3 at 4 KiB, 90 -> 103 MiB. What grows is not known
+/// yet (not the image buffers, the inspections or the saves, which are bounded).
 const ALLOCATOR: (&str, &str) = ("GLIBC_TUNABLES", "glibc.malloc.mmap_threshold=4096");
 /// The longest wait for the window to finish a view (many_100000 at 2560×1440 takes
 /// seconds on two busy cores).
