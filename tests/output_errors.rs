@@ -218,3 +218,357 @@ fn writing_to_a_full_device_fails_and_leaves_it_alone() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
 }
+
+/// Sends `signal` (a name for kill(1): TERM, INT) to process `pid`.
+fn send(signal: &str, pid: u32) {
+    let sent = Command::new("kill")
+        .args([&format!("-{signal}"), &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success(), "kill -{signal} {pid}");
+}
+
+/// Waits until process `pid` catches SIGTERM (its handler is installed: a signal from
+/// then on is the program's to handle, not a kill).
+fn wait_for_handler(pid: u32) {
+    wait_until("the signal handler", || {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+        let caught = status
+            .lines()
+            .find_map(|l| l.strip_prefix("SigCgt:"))
+            .and_then(|mask| u64::from_str_radix(mask.trim(), 16).ok())
+            .unwrap_or(0);
+        caught & (1 << (libc::SIGTERM - 1)) != 0
+    });
+}
+
+/// Polls until `ready` holds (at most two minutes).
+fn wait_until(what: &str, mut ready: impl FnMut() -> bool) {
+    let start = Instant::now();
+    while !ready() {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "timed out waiting for {what}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// `whitted render` of the turntable (hw3 with an animation) at 320x180, `frames`
+/// frames, into `outputs`, started in the background.
+fn animation(frames: u32, outputs: &[&Path]) -> std::process::Child {
+    let mut c = whitted();
+    c.args(["render", "assets/scenes/turntable.toml", "--quiet"])
+        .args(["--width", "320", "--height", "180"])
+        .args(["--frames", &frames.to_string()]);
+    for out in outputs {
+        c.arg("-o").arg(out);
+    }
+    c.stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// The files in `dir` that are not hidden (temporary files start with a dot).
+fn finished(dir: &Path) -> usize {
+    common::entries(dir)
+        .iter()
+        .filter(|n| !n.starts_with('.'))
+        .count()
+}
+
+/// The numbered PNG frames `f-NN.png` in `dir` (asserting that nothing else is there),
+/// each decoded whole at 320x180; frame 0 equals a render of frame 0 alone.
+fn whole_frames(dir: &Path) -> usize {
+    let names = common::entries(dir);
+    for (k, name) in names.iter().enumerate() {
+        assert_eq!(name, &format!("f-{k:02}.png"), "{names:?}");
+        let frame = image::open(dir.join(name))
+            .unwrap_or_else(|e| panic!("{name} is not whole: {e}"))
+            .to_rgb8();
+        assert_eq!(frame.dimensions(), (320, 180), "{name}");
+    }
+    let alone = tempfile::tempdir().unwrap();
+    let first = alone.path().join("f0.png");
+    let out = whitted()
+        .args(["render", "assets/scenes/turntable.toml", "--quiet"])
+        .args(["--width", "320", "--height", "180", "--frame", "0", "-o"])
+        .arg(&first)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let kept = std::fs::read(dir.join("f-00.png")).unwrap();
+    assert_eq!(kept, std::fs::read(&first).unwrap(), "f-00.png");
+    names.len()
+}
+
+/// SIGTERM while an animation is written as numbered frames and a GIF: exit 1 with one
+/// line, the frames finished before the signal kept whole, no GIF and no temporary
+/// file left.
+#[test]
+fn sigterm_during_an_animation_keeps_finished_frames_and_no_partial_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, gif) = (dir.path().join("frames"), dir.path().join("gif"));
+    std::fs::create_dir(&frames).unwrap();
+    std::fs::create_dir(&gif).unwrap();
+    let child = animation(200, &[&frames.join("f-%02d.png"), &gif.join("out.gif")]);
+    wait_until("three frames", || finished(&frames) >= 3);
+    send("TERM", child.id());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("SIGTERM during an animation: {:?} {stderr:?}", out.status);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    assert_eq!(common::entries(&gif), Vec::<String>::new(), "left in gif/");
+    let kept = whole_frames(&frames);
+    println!("kept {kept} whole frames");
+    assert!((3..200).contains(&kept), "{kept} frames");
+}
+
+/// Parts of a 1280x720 image (four EXR tiles) in `dir`, and the image stitched from
+/// them into `whole.ppm` (plain PPM: large, so that stitching takes a while).
+fn parts_and_whole(dir: &Path) -> (Vec<String>, Vec<u8>, Duration) {
+    let parts: Vec<String> = (0..4)
+        .map(|i| {
+            let part = dir.join(format!("part-{i}.exr"));
+            let out = whitted()
+                .args(["render", "--width", "1280", "--height", "720", "--quiet"])
+                .args(["--tile", &format!("{i}/4"), "-o"])
+                .arg(&part)
+                .output()
+                .unwrap();
+            assert!(out.status.success(), "{out:?}");
+            part.display().to_string()
+        })
+        .collect();
+    let whole = dir.join("whole.ppm");
+    let start = Instant::now();
+    let out = whitted()
+        .args(["stitch", "-o", whole.to_str().unwrap()])
+        .args(&parts)
+        .output()
+        .unwrap();
+    let took = start.elapsed();
+    assert!(out.status.success(), "{out:?}");
+    let bytes = std::fs::read(&whole).unwrap();
+    std::fs::remove_file(&whole).unwrap();
+    (parts, bytes, took)
+}
+
+/// SIGTERM at several moments of a `whitted stitch`: each time, either exit 1 with
+/// one line and nothing written, or exit 0 with the whole image; never a partial or
+/// temporary file. The first signal comes as soon as the handler is in place, before
+/// the end.
+#[test]
+fn sigterm_during_a_stitch_leaves_the_whole_image_or_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let (parts, whole, took) = parts_and_whole(dir.path());
+    let out_dir = dir.path().join("out");
+    std::fs::create_dir(&out_dir).unwrap();
+    let target = out_dir.join("whole.ppm");
+    let mut interrupted = 0;
+    for share in [0.0, 0.3, 0.6, 1.2] {
+        let delay = took.mul_f64(share);
+        let child = whitted()
+            .args(["stitch", "-o", target.to_str().unwrap()])
+            .args(&parts)
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        wait_for_handler(child.id());
+        std::thread::sleep(delay);
+        let _ = Command::new("kill")
+            .args(["-TERM", &child.id().to_string()])
+            .status();
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let left = common::entries(&out_dir);
+        println!(
+            "SIGTERM {:.0} ms after the handler, in a {:.0} ms stitch: {:?} {stderr:?} left {left:?}",
+            delay.as_secs_f64() * 1e3,
+            took.as_secs_f64() * 1e3,
+            out.status.code()
+        );
+        match out.status.code() {
+            Some(1) => {
+                interrupted += 1;
+                assert_eq!(stderr.lines().count(), 1, "{stderr}");
+                assert!(stderr.contains("interrupted"), "{stderr}");
+                assert!(left.is_empty(), "left behind: {left:?}");
+            }
+            Some(0) => {
+                assert_eq!(left, ["whole.ppm"]);
+                assert!(std::fs::read(&target).unwrap() == whole, "not whole");
+                std::fs::remove_file(&target).unwrap();
+            }
+            other => panic!("stitch ended with {other:?} (killed?): {stderr}"),
+        }
+    }
+    assert!(interrupted > 0, "no signal came before the end of a stitch");
+}
+
+/// A FIFO with no reader: the write waits for one, and Ctrl-C or SIGTERM ends the
+/// wait with exit 1 and one line, the FIFO left as it was and nothing beside it. For a
+/// still render, an animation (the file is opened before the first frame) and a
+/// stitch.
+#[test]
+fn a_signal_ends_the_wait_for_a_fifo_reader() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let part = dir.path().join("part.png");
+    let out = whitted()
+        .args(["render", "--width", "32", "--height", "18", "--quiet"])
+        .args(["--tile", "0/1", "-o"])
+        .arg(&part)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let pipes = dir.path().join("pipes");
+    std::fs::create_dir(&pipes).unwrap();
+    let part = part.display().to_string();
+    let cases: [(&str, &str, Vec<&str>); 3] = [
+        (
+            "INT",
+            "still.png",
+            vec!["render", "--width", "32", "--height", "18", "--quiet"],
+        ),
+        (
+            "TERM",
+            "moving.gif",
+            vec!["render", "--width", "32", "--height", "18", "--frames", "3"],
+        ),
+        ("TERM", "stitched.png", vec!["stitch", &part]),
+    ];
+    for (signal, name, args) in cases {
+        let fifo = pipes.join(name);
+        let made = Command::new("mkfifo").arg(&fifo).status();
+        if !made.is_ok_and(|s| s.success()) {
+            common::skip("FIFO test", "mkfifo failed here", "writing into a FIFO");
+            return;
+        }
+        let child = whitted()
+            .args(&args)
+            .arg("-o")
+            .arg(&fifo)
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Time to render (the still) and come to the wait.
+        std::thread::sleep(Duration::from_millis(1500));
+        send(signal, child.id());
+        let sent = Instant::now();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(child.wait_with_output()));
+        let Ok(out) = rx.recv_timeout(Duration::from_secs(30)) else {
+            // Open the FIFO for reading, so that the writer (and this test) can end.
+            let _ = std::fs::read(&fifo);
+            panic!("{name}: SIG{signal} did not end the wait for a reader");
+        };
+        let out = out.unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        println!(
+            "{name}: SIG{signal}, stopped after {:.2} s: {:?} {stderr:?}",
+            sent.elapsed().as_secs_f64(),
+            out.status.code()
+        );
+        assert_eq!(out.status.code(), Some(1), "{name}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{name}: {stderr}");
+        assert!(stderr.contains("interrupted"), "{name}: {stderr}");
+        let still_fifo = std::fs::symlink_metadata(&fifo).is_ok_and(|m| m.file_type().is_fifo());
+        assert!(still_fifo, "{name}: the FIFO was replaced");
+        std::fs::remove_file(&fifo).unwrap();
+        assert!(
+            common::entries(&pipes).is_empty(),
+            "{:?}",
+            common::entries(&pipes)
+        );
+    }
+}
+
+/// The folder of the GIF removed while the animation renders: exit 1 at the next
+/// frame with one line, the numbered frames in another folder kept whole. Then the
+/// folder of the numbered frames removed: exit 1, and no GIF (nor temporary file) in
+/// its folder.
+#[test]
+fn a_folder_removed_mid_run_stops_the_animation_and_keeps_finished_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (frames, gif) = (dir.path().join("frames"), dir.path().join("gif"));
+    for (removed, kept) in [(&gif, &frames), (&frames, &gif)] {
+        std::fs::create_dir(&frames).unwrap();
+        std::fs::create_dir(&gif).unwrap();
+        let child = animation(200, &[&frames.join("f-%02d.png"), &gif.join("out.gif")]);
+        wait_until("two frames", || finished(&frames) >= 2);
+        std::fs::remove_dir_all(removed).unwrap();
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let what = removed.file_name().unwrap().to_string_lossy();
+        println!("{what}/ removed: {:?} {stderr:?}", out.status.code());
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains(&*what), "{stderr}");
+        if kept == &frames {
+            let n = whole_frames(&frames);
+            assert!((2..200).contains(&n), "{n} frames: the render went on");
+        } else {
+            assert!(
+                common::entries(&gif).is_empty(),
+                "{:?}",
+                common::entries(&gif)
+            );
+        }
+        std::fs::remove_dir_all(kept).unwrap();
+    }
+}
+
+/// A full disk (a 2 MiB tmpfs) while an animation is written as numbered plain PPM
+/// frames and an APNG into it: exit 1 with one line; the frames that fitted are
+/// whole, the one that did not is not there, and no APNG or temporary file is left.
+#[test]
+fn a_disk_filling_up_mid_animation_keeps_the_frames_that_fitted() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mnt, kept) = (dir.path().join("mnt"), dir.path().join("kept"));
+    std::fs::create_dir(&mnt).unwrap();
+    std::fs::create_dir(&kept).unwrap();
+    let (mnt_s, kept_s) = (mnt.display(), kept.display());
+    let bin = env!("CARGO_BIN_EXE_whitted");
+    // A plain PPM frame of 320x180 is about 500 KB: three or four fit.
+    let script = format!(
+        "mount -t tmpfs -o size=2m tmpfs '{mnt_s}' || exit 99; \
+         '{bin}' render assets/scenes/turntable.toml --quiet --width 320 --height 180 \
+         --frames 24 -o '{mnt_s}/f-%02d.ppm' -o '{mnt_s}/out.apng'; \
+         echo \"rc=$?\"; cp -a '{mnt_s}/.' '{kept_s}/'"
+    );
+    let what = "a full disk during an animation";
+    let Some(out) = in_mount_namespace(&script) else {
+        common::skip(
+            what,
+            "cannot create user/mount namespaces (unshare -rm) here",
+            "a full file system",
+        );
+        return;
+    };
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if out.status.code() == Some(99) {
+        common::skip(
+            what,
+            &format!("cannot mount a tmpfs in a namespace: {stderr}"),
+            "a full file system",
+        );
+        return;
+    }
+    let names = common::entries(&kept);
+    println!("{what}: {stdout:?} {stderr:?} left {names:?}");
+    assert_eq!(stdout.trim(), "rc=1", "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(names.len() >= 2, "{names:?}");
+    for (k, name) in names.iter().enumerate() {
+        assert_eq!(name, &format!("f-{k:02}.ppm"), "{names:?}");
+        let frame = image::open(kept.join(name))
+            .unwrap_or_else(|e| panic!("{name} is not whole: {e}"))
+            .to_rgb8();
+        assert_eq!(frame.dimensions(), (320, 180), "{name}");
+    }
+}

@@ -204,6 +204,9 @@ pub(crate) fn render_frames(
         }
         targets.push(output);
     }
+    // Before the animated files are opened: a FIFO waits for its reader there.
+    let control = Arc::new(RenderControl::default());
+    super::stop_on_signals(Some(Arc::clone(&control)))?;
     let mut animated = Vec::new();
     for output in &targets {
         if let Output::Animated(path, format) = output {
@@ -221,12 +224,6 @@ pub(crate) fn render_frames(
             )
         });
 
-    let control = Arc::new(RenderControl::default());
-    {
-        let control = Arc::clone(&control);
-        ctrlc::set_handler(move || control.cancel())
-            .context("cannot install the interrupt handler")?;
-    }
     let done = Arc::new(AtomicU64::new(0));
     let show_progress = !quiet && std::io::stderr().is_terminal();
     let progress = show_progress.then(|| {

@@ -43,6 +43,22 @@ pub(crate) fn whole_number(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, Str
     }
 }
 
+/// On Ctrl-C, SIGTERM or SIGHUP: cancels `control` (the render stops within a row
+/// of pixels) and interrupts the writing of files (none is put in place any more), so
+/// that the command ends with exit status 1 and leaves no partial file; files
+/// complete before the signal stay.
+pub(crate) fn stop_on_signals(
+    control: Option<std::sync::Arc<whitted::render::RenderControl>>,
+) -> anyhow::Result<()> {
+    ctrlc::set_handler(move || {
+        if let Some(control) = &control {
+            control.cancel();
+        }
+        whitted::image_io::interrupt_writes();
+    })
+    .context("cannot install the interrupt handler")
+}
+
 /// The built-in scene, embedded from the file the generator wrote
 /// (`whitted scene hw3 > assets/scenes/hw3.toml`); a test keeps the two in step.
 pub(crate) const BUILTIN_SCENE: &str = include_str!("../../assets/scenes/hw3.toml");

@@ -5,7 +5,7 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use anyhow::{anyhow, Context};
+use anyhow::anyhow;
 use clap::Args;
 
 use whitted::image_io::parts::{self, Placement};
@@ -125,11 +125,7 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     opts.check()?;
 
     let control = Arc::new(RenderControl::default());
-    {
-        let control = Arc::clone(&control);
-        ctrlc::set_handler(move || control.cancel())
-            .context("cannot install the interrupt handler")?;
-    }
+    super::stop_on_signals(Some(Arc::clone(&control)))?;
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let area = opts.area();
     let progress = show_progress.then(|| {

@@ -33,11 +33,14 @@ fn parse_image_path(text: &str) -> Result<PathBuf, String> {
 pub(crate) fn stitch_command(args: StitchArgs) -> anyhow::Result<()> {
     let format = Format::from_path(&args.output, args.ppm_binary)?;
     image_io::check_writable(&args.output)?;
-    let read: Vec<(String, parts::Part)> = args
-        .parts
-        .iter()
-        .map(|p| Ok((p.display().to_string(), parts::read_part(p)?)))
-        .collect::<Result<_, parts::StitchError>>()?;
+    super::stop_on_signals(None)?;
+    let mut read: Vec<(String, parts::Part)> = Vec::new();
+    for path in &args.parts {
+        if image_io::writes_interrupted() {
+            bail!("interrupted: {} was not written", args.output.display());
+        }
+        read.push((path.display().to_string(), parts::read_part(path)?));
+    }
     match parts::stitch(&read)? {
         PartPixels::Linear(image) => {
             let encoding = read[0].1.placement.encoding;

@@ -1,9 +1,9 @@
 //! Animated files, one frame at a time: GIF through the `image` crate's encoder
 //! (NeuQuant palette per frame), APNG through the `png` crate. Each frame goes to
 //! the file as soon as it is added, so an animation of any length holds one frame in
-//! memory; the file appears (renamed over the target) only when the last frame is in.
+//! memory; the file appears (an [`AtomicFile`] put in place) only when the last frame
+//! is in.
 
-use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 use std::sync::{Arc, Mutex, PoisonError};
@@ -11,7 +11,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, RgbImage, RgbaImage};
 
-use super::{target_of, temp_file_for, SaveError, Target};
+use super::{AtomicFile, SaveError};
 
 /// The animated formats, chosen by extension (`.gif`, `.apng`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,32 +55,9 @@ pub fn apng_delay(fps: f64) -> (u16, u16) {
     }
 }
 
-/// Where the bytes go: a temporary file beside the target (renamed over it at the
-/// end), or a device or FIFO written in place.
-enum Sink {
-    Temp(tempfile::NamedTempFile),
-    Special(File),
-}
-
-impl Write for Sink {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        match self {
-            Sink::Temp(f) => f.write(buf),
-            Sink::Special(f) => f.write(buf),
-        }
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        match self {
-            Sink::Temp(f) => f.flush(),
-            Sink::Special(f) => f.flush(),
-        }
-    }
-}
-
 /// The sink shared with an encoder that owns its writer and never gives it back.
 #[derive(Clone)]
-struct Shared(Arc<Mutex<BufWriter<Sink>>>);
+struct Shared(Arc<Mutex<BufWriter<AtomicFile>>>);
 
 impl Write for Shared {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
@@ -128,18 +105,7 @@ impl AnimatedWriter {
             path: path.display().to_string(),
             message,
         };
-        if path.is_dir() {
-            return Err(err("is a folder".into()));
-        }
-        let sink = match target_of(path) {
-            Target::Special => Sink::Special(
-                std::fs::OpenOptions::new()
-                    .write(true)
-                    .open(path)
-                    .map_err(|e| err(e.to_string()))?,
-            ),
-            Target::File(real) => Sink::Temp(temp_file_for(&real)?),
-        };
+        let sink = AtomicFile::create(path)?;
         let sink = Shared(Arc::new(Mutex::new(BufWriter::new(sink))));
         let encoder = match format {
             AnimatedFormat::Gif => {
@@ -184,6 +150,12 @@ impl AnimatedWriter {
 
     /// Encodes and writes the next frame.
     pub fn add(&mut self, frame: &RgbImage) -> Result<(), SaveError> {
+        self.sink
+            .0
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .get_ref()
+            .check_still_there()?;
         if frame.dimensions() != self.size {
             let (w, h) = frame.dimensions();
             return Err(self.err(format!(
@@ -231,20 +203,9 @@ impl AnimatedWriter {
             .map_err(|_| err("the encoder still holds the file".into()))?
             .into_inner()
             .unwrap_or_else(PoisonError::into_inner);
-        let sink = buffered
+        let file = buffered
             .into_inner()
             .map_err(|e| err(e.error().to_string()))?;
-        match sink {
-            Sink::Special(mut file) => file.flush().map_err(|e| err(e.to_string())),
-            Sink::Temp(temp) => {
-                temp.as_file().sync_all().map_err(|e| err(e.to_string()))?;
-                let real = match target_of(&path) {
-                    Target::File(real) => real,
-                    Target::Special => path.clone(),
-                };
-                temp.persist(&real).map_err(|e| err(e.error.to_string()))?;
-                Ok(())
-            }
-        }
+        file.commit()
     }
 }

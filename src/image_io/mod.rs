@@ -1,10 +1,10 @@
 //! The frame buffer to bytes and files, through the `image` crate. This is where the
 //! bottom-up frame is flipped to the top-down order of files, once, and where linear
 //! values become 8-bit bytes in the settings' [`Encoding`] (EXR stays linear). Every
-//! file is written whole or not at all: into a temporary file beside the target, then
-//! renamed.
+//! file is written whole or not at all ([`AtomicFile`]).
 
 mod animated;
+mod atomic;
 
 use std::io::{BufRead, Cursor, Seek, Write};
 use std::path::{Path, PathBuf};
@@ -24,6 +24,9 @@ pub use srgb::{to_byte_srgb, to_byte_srgb_exact, SrgbTable};
 
 pub mod parts;
 pub use animated::{apng_delay, gif_delay_centiseconds, AnimatedFormat, AnimatedWriter};
+pub use atomic::{
+    check_writable, interrupt_writes, write_atomically, writes_interrupted, AtomicFile,
+};
 
 /// The file formats `whitted` writes, chosen by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -231,110 +234,6 @@ pub fn encode_rgb8(
         Format::Exr => return Err(EncodeError::ExrFromBytes),
     };
     Ok(result?)
-}
-
-/// The folder a file at `path` goes into (`.` for a bare file name).
-fn folder_of(path: &Path) -> &Path {
-    match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    }
-}
-
-/// A temporary file beside `path`, where [`write_atomically`] puts the bytes first.
-fn temp_file_for(path: &Path) -> Result<tempfile::NamedTempFile, SaveError> {
-    let dir = folder_of(path);
-    let err = |message: String| SaveError {
-        path: path.display().to_string(),
-        message,
-    };
-    match std::fs::metadata(dir) {
-        Err(e) => return Err(err(format!("cannot use the folder {}: {e}", dir.display()))),
-        Ok(m) if !m.is_dir() => {
-            return Err(err(format!("{} is not a folder", dir.display())));
-        }
-        Ok(_) => {}
-    }
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".whitted-").suffix(".part");
-    // tempfile makes private (0600) files; an image is an ordinary file, readable as
-    // the user's umask allows, like any file a program creates.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    builder.tempfile_in(dir).map_err(|e| {
-        // tempfile appends the random name it tried, which means nothing to the user.
-        let text = e.to_string();
-        let reason = text.split(" at path ").next().unwrap_or(&text);
-        err(format!("cannot write into {}: {reason}", dir.display()))
-    })
-}
-
-/// What a path to save to really is.
-enum Target {
-    /// A regular file, or nothing yet: replaced atomically at this path. A symbolic
-    /// link is resolved first, so that it keeps pointing at the new image.
-    File(PathBuf),
-    /// An existing device, FIFO or socket: it cannot be replaced (and must not be:
-    /// renaming over `/dev/full` would swallow the error), so it is written in place.
-    Special,
-}
-
-fn target_of(path: &Path) -> Target {
-    match std::fs::metadata(path) {
-        Ok(m) if !m.is_file() && !m.is_dir() => Target::Special,
-        Ok(_) => Target::File(std::fs::canonicalize(path).unwrap_or_else(|_| path.into())),
-        Err(_) => Target::File(path.into()),
-    }
-}
-
-/// Fails unless a file can be created in the folder of `path`: lets a command refuse
-/// an unwritable target before it spends time rendering. Leaves nothing behind.
-pub fn check_writable(path: &Path) -> Result<(), SaveError> {
-    if path.is_dir() {
-        return Err(SaveError {
-            path: path.display().to_string(),
-            message: "is a folder".into(),
-        });
-    }
-    match target_of(path) {
-        // Opening a FIFO would wait for a reader: the write will tell.
-        Target::Special => Ok(()),
-        Target::File(real) => temp_file_for(&real).map(drop),
-    }
-}
-
-/// Writes `bytes` into `path` atomically: a temporary file in the same folder, flushed
-/// and synced, then renamed over the target. On any error nothing is left behind (the
-/// temporary file deletes itself when dropped). A device or FIFO is written in place.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SaveError> {
-    let err = |message: String| SaveError {
-        path: path.display().to_string(),
-        message,
-    };
-    if path.is_dir() {
-        return Err(err("is a folder".into()));
-    }
-    match target_of(path) {
-        Target::Special => {
-            let mut file = std::fs::OpenOptions::new()
-                .write(true)
-                .open(path)
-                .map_err(|e| err(e.to_string()))?;
-            file.write_all(bytes)
-                .and_then(|()| file.flush())
-                .map_err(|e| err(e.to_string()))
-        }
-        Target::File(real) => {
-            let mut temp = temp_file_for(&real)?;
-            temp.write_all(bytes).map_err(|e| err(e.to_string()))?;
-            temp.as_file().sync_all().map_err(|e| err(e.to_string()))?;
-            temp.persist(&real).map_err(|e| err(e.error.to_string()))?;
-            Ok(())
-        }
-    }
 }
 
 /// The frame encoded in `format`, its bytes in `encoding` (EXR: linear values).

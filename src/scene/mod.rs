@@ -16,7 +16,7 @@ use crate::settings::{Overrides, Settings};
 pub use animation::{look_at_form, Animation, CameraKey, Motion};
 pub use hw3::{hw3_scene, hw3_toml, HW3_DEFAULT_SEED};
 pub use many::many_scene;
-pub use write::to_toml;
+pub use write::{camera_to_toml, to_toml};
 
 /// A ball of the scene (SPEC §2, "Scene contents").
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -122,33 +122,46 @@ struct OutSphere {
     ior: f64,
 }
 
+fn out_camera(spec: CameraSpec) -> OutCamera {
+    match spec {
+        CameraSpec::LookAt {
+            look_from,
+            look_at,
+            up,
+            vfov,
+        } => OutCamera::LookAt {
+            look_from: look_from.to_array(),
+            look_at: look_at.to_array(),
+            up: up.to_array(),
+            vfov,
+        },
+        CameraSpec::Frame {
+            origin,
+            lower_left,
+            horizontal,
+            vertical,
+        } => OutCamera::Frame {
+            origin: origin.to_array(),
+            lower_left: lower_left.to_array(),
+            horizontal: horizontal.to_array(),
+            vertical: vertical.to_array(),
+        },
+    }
+}
+
+/// The camera as a TOML inline table, `{ look_from = [..], .. }`: one line that
+/// `camera = ` makes the `[camera]` table of a scene file (the viewer prints it when it
+/// saves, so that `whitted render` can render the same view).
+pub fn camera_to_toml(spec: &CameraSpec) -> String {
+    toml::Value::try_from(out_camera(*spec))
+        .expect("a camera of finite numbers always serialises")
+        .to_string()
+}
+
 /// The scene as TOML; loading the text gives the same scene back.
 pub fn to_toml(scene: &Scene) -> String {
     let out = OutScene {
-        camera: scene.camera.map(|c| match c {
-            CameraSpec::LookAt {
-                look_from,
-                look_at,
-                up,
-                vfov,
-            } => OutCamera::LookAt {
-                look_from: look_from.to_array(),
-                look_at: look_at.to_array(),
-                up: up.to_array(),
-                vfov,
-            },
-            CameraSpec::Frame {
-                origin,
-                lower_left,
-                horizontal,
-                vertical,
-            } => OutCamera::Frame {
-                origin: origin.to_array(),
-                lower_left: lower_left.to_array(),
-                horizontal: horizontal.to_array(),
-                vertical: vertical.to_array(),
-            },
-        }),
+        camera: scene.camera.map(out_camera),
         image: OutImage {
             width: scene.image.width,
             height: scene.image.height,
@@ -185,4 +198,32 @@ pub fn to_toml(scene: &Scene) -> String {
             .collect(),
     };
     toml::to_string(&out).expect("a scene of finite numbers always serialises")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// A scene whose text is `camera = ` and the printed camera, then `[image]`.
+    fn camera_of(inline: &str) -> Option<CameraSpec> {
+        let text = format!("camera = {inline}\n[image]\nwidth = 4\nheight = 3\n");
+        Scene::from_toml_str(&text, "camera.toml").unwrap().camera
+    }
+
+    #[test]
+    fn a_printed_camera_is_one_line_that_loads_back_bit_for_bit() {
+        let look_at = CameraSpec::LookAt {
+            look_from: DVec3::new(0.1, 1.0 / 3.0, -2.5e-7),
+            look_at: DVec3::new(123_456.789e3, -0.0, 7.000000000000001),
+            up: DVec3::Y,
+            vfov: 45.000000000000014,
+        };
+        let frame = CameraSpec::assignment_frame();
+        for spec in [look_at, frame] {
+            let line = camera_to_toml(&spec);
+            assert!(!line.contains('\n') && line.starts_with('{'), "{line}");
+            assert_eq!(camera_of(&line), Some(spec), "{line}");
+        }
+    }
 }

@@ -23,6 +23,16 @@ pub fn to_rgba_top_down(frame: &Frame, encoding: Encoding) -> Vec<u8> {
     bytes
 }
 
+/// `buffer` resized to `len` for reuse, and its memory given back when it is far
+/// larger than that: after the window has been large, a smaller one does not keep the
+/// large one's memory.
+pub fn resize_buffer<T: Clone>(buffer: &mut Vec<T>, len: usize, value: T) {
+    buffer.resize(len, value);
+    if buffer.capacity() > len.saturating_mul(2) {
+        buffer.shrink_to_fit();
+    }
+}
+
 /// The rows of an RGBA buffer (row 0 at the top), for image rows `j` counted from the
 /// bottom, each behind its own lock: a pass converts its rows as it traces them, on
 /// whichever thread traced them, while they are still in cache (a separate fill after
@@ -36,7 +46,7 @@ impl<'a> ScreenRows<'a> {
     /// `rgba` resized for `width`×`height`, to be filled in `encoding`.
     pub fn new(rgba: &'a mut Vec<u8>, width: u32, height: u32, encoding: Encoding) -> Self {
         let w = (width as usize).max(1);
-        rgba.resize(width as usize * height as usize * 4, 0);
+        resize_buffer(rgba, width as usize * height as usize * 4, 0);
         ScreenRows {
             rows: rgba
                 .chunks_mut(w * 4)
@@ -95,7 +105,7 @@ pub fn fill_for_screen(
 ) {
     let w = (frame.width as usize).max(1);
     let n = frame.width as usize * frame.height as usize;
-    frame.pixels.resize(n, Vec3::ZERO);
+    resize_buffer(&mut frame.pixels, n, Vec3::ZERO);
     let screen = ScreenRows::new(rgba, frame.width, frame.height, encoding);
     frame
         .pixels
@@ -127,8 +137,8 @@ pub fn fill_upscaled_for_screen(
     let (w, factor) = (frame.width as usize, factor.max(1) as usize);
     let bytes_of = ByteEncoder::new(encoding);
     let n = w * frame.height as usize;
-    frame.pixels.resize(n, Vec3::ZERO);
-    rgba.resize(n * 4, 0);
+    resize_buffer(&mut frame.pixels, n, Vec3::ZERO);
+    resize_buffer(rgba, n * 4, 0);
     let pw = width as usize;
     let ph = preview.len().checked_div(pw).unwrap_or(0);
     if n == 0 || ph == 0 {

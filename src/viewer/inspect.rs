@@ -5,6 +5,8 @@
 //! error messages (the tracer's records count from 0).
 
 use std::fmt::Write;
+use std::sync::mpsc::{self, Sender};
+use std::sync::Arc;
 
 use glam::{DVec3, Vec3};
 
@@ -14,6 +16,53 @@ use crate::trace::reference::{RayNode, ReferenceTracer};
 
 fn v3(v: DVec3) -> String {
     format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)
+}
+
+/// A click to answer: pixel `(i, j)` of a `width`×`height` view of `scene`, and its
+/// value on screen.
+pub struct Request {
+    /// The scene, its camera the view's.
+    pub scene: Arc<Scene>,
+    /// The view's width and height.
+    pub size: (u32, u32),
+    /// `(i, j)`, `j` from the bottom.
+    pub pixel: (u32, u32),
+    /// The pixel's value on screen.
+    pub shown: Vec3,
+}
+
+/// The thread that answers clicks, one at a time and in order, printing each report.
+/// Each builds the `f64` tracer of the whole scene (tens of MB for 100,000 spheres):
+/// clicks in quick succession wait their turn rather than build side by side. The
+/// thread ends once the window has let go of this handle and the queue is empty.
+pub struct Inspector {
+    requests: Sender<Request>,
+}
+
+impl Inspector {
+    /// Starts the thread.
+    pub fn spawn() -> Inspector {
+        let (requests, queue) = mpsc::channel::<Request>();
+        std::thread::Builder::new()
+            .name("whitted-inspect".into())
+            .spawn(move || {
+                for r in queue {
+                    let ((w, h), (i, j)) = (r.size, r.pixel);
+                    match report(&r.scene, w, h, i, j, r.shown) {
+                        Ok(text) => print!("{text}"),
+                        Err(e) => eprintln!("whitted: cannot inspect the pixel: {e}"),
+                    }
+                }
+            })
+            .expect("cannot start the inspector thread");
+        Inspector { requests }
+    }
+
+    /// Queues a click.
+    pub fn inspect(&self, request: Request) {
+        // The thread only ends when this sender is dropped.
+        let _ = self.requests.send(request);
+    }
 }
 
 /// The report for pixel `(i, j)` of a `width`×`height` view of `scene` (whose camera

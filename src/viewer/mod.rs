@@ -127,6 +127,7 @@ struct App {
     drag: Option<Drag>,
     numbering: save::Numbering,
     saves: Vec<JoinHandle<()>>,
+    inspector: inspect::Inspector,
     first_frame_reported: bool,
     /// Holds camera changes while the current view has nothing on screen.
     throttle: schedule::Throttle,
@@ -180,6 +181,7 @@ impl App {
             drag: None,
             numbering: save::Numbering::default(),
             saves: Vec::new(),
+            inspector: inspect::Inspector::spawn(),
             first_frame_reported: false,
             throttle: schedule::Throttle::default(),
             speed: f64::NAN,
@@ -342,18 +344,30 @@ impl App {
         if let Some((k, n)) = self.frame_label(self.shown_frame) {
             what += &format!(", frame {k}/{n}");
         }
+        // The view's camera as a scene file states it: `whitted render` with it (and
+        // this size) renders these pixels again.
+        let camera = scene
+            .camera
+            .map(|spec| format!("; camera = {}", crate::scene::camera_to_toml(&spec)))
+            .unwrap_or_default();
         let (png, ppm) = self
             .numbering
             .next(Path::new(""), &self.stem, |p| p.exists());
+        // Finished saves are joined: a thread not joined keeps its stack.
+        self.saves.retain(|save| !save.is_finished());
         self.saves.push(std::thread::spawn(move || {
             match save::save_pair(&frame, &png, &ppm, encoding) {
-                Ok(()) => println!("saved {} and {} ({what})", png.display(), ppm.display()),
+                Ok(()) => println!(
+                    "saved {} and {} ({what}){camera}",
+                    png.display(),
+                    ppm.display()
+                ),
                 Err(e) => eprintln!("whitted: cannot save: {e}"),
             }
         }));
     }
 
-    /// Prints the ray tree of the pixel under the cursor, on a thread of its own.
+    /// Prints the ray tree of the pixel under the cursor (on the inspector's thread).
     fn inspect(&self, position: (f64, f64)) {
         let (Some((shown, scene)), Some(blitter)) = (&self.shown, &self.blitter) else {
             return;
@@ -362,14 +376,12 @@ impl App {
         let Some((i, j)) = blitter.pixel_at(position, size, self.size) else {
             return;
         };
-        let value = shown.frame.get(i, j);
-        let scene = Arc::clone(scene);
-        std::thread::spawn(
-            move || match inspect::report(&scene, size.0, size.1, i, j, value) {
-                Ok(text) => print!("{text}"),
-                Err(e) => eprintln!("whitted: cannot inspect the pixel: {e}"),
-            },
-        );
+        self.inspector.inspect(inspect::Request {
+            scene: Arc::clone(scene),
+            size,
+            pixel: (i, j),
+            shown: shown.frame.get(i, j),
+        });
     }
 
     fn frame_ready(&mut self, shown: Shown) {

@@ -52,7 +52,8 @@ pub fn title_of_frame(
 
 pub const HELP: &str = "\
 whitted viewer keys:
-  S                  save the image on screen as PNG and PPM (numbered names)
+  S                  save the image on screen as PNG and PPM (numbered names);
+                     the line printed gives the view's camera
   Esc, Q             quit
   arrows             move forward/back, left/right
   PageUp, PageDown   move up/down

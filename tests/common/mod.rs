@@ -3,6 +3,9 @@
 
 use std::process::{Command, Output};
 
+#[cfg(all(feature = "cli", feature = "viewer"))]
+pub mod x11;
+
 /// Runs `whitted` with `args` and returns what it did.
 pub fn run(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_whitted"))
