@@ -113,21 +113,22 @@ fn fast_matches_reference_with_several_samples_a_pixel() {
 #[test]
 fn fast_matches_reference_in_a_region() {
     let scene = hw3_lit(&TWO_LIGHTS);
+    // Across the balls and the ground, where a shift in x or y changes pixels.
     let region = Region {
-        x: 37,
-        y: 11,
-        width: 90,
-        height: 50,
+        x: 97,
+        y: 71,
+        width: 120,
+        height: 60,
     };
     compare(
-        "hw3 region 37,11,90,50 of 320x180, 1 spp",
+        "hw3 region 97,71,120,60 of 320x180, 1 spp",
         &scene,
         (320, 180),
         1,
         Some(region),
     );
     compare(
-        "hw3 region 37,11,90,50 of 320x180, 2 spp",
+        "hw3 region 97,71,120,60 of 320x180, 2 spp",
         &scene,
         (320, 180),
         2,
