@@ -150,6 +150,21 @@ fn total_internal_reflection_beyond_the_critical_angle() {
     assert!(crosses && t.y > 0.0 && (t.x - 1.5 * theta.sin()).abs() < 1e-12);
 }
 
+/// Exactly at the critical angle `k = 0`, and SPEC §2 calls only `k < 0` total internal
+/// reflection: the ray leaves along the surface. With `cos i = 1/2` (an exact dot
+/// product) and `ior = √(4/3)` (whose square times 3/4 rounds to exactly 1 in `f64`),
+/// `k = 1 − ior²·(1 − 1/4)` is exactly 0 and the direction is `ior·d + (ior/2)·N`,
+/// which is `(ior·√¾, 0, 0)`: along +x.
+#[test]
+fn at_exactly_the_critical_angle_the_ray_leaves_along_the_surface() {
+    let ior = (4.0f64 / 3.0).sqrt();
+    assert_eq!(1.0 - ior * ior * (1.0 - 0.5 * 0.5), 0.0, "k is exactly 0");
+    let d = DVec3::new(0.75f64.sqrt(), 0.5, 0.0);
+    let (t, crosses) = model::transmit(d, DVec3::Y, false, ior);
+    assert!(crosses, "k = 0 is not total internal reflection");
+    assert!(close(t, DVec3::X, 1e-15), "{t}");
+}
+
 #[test]
 fn shadow_factor_of_an_occluder() {
     let l = DVec3::Z;
