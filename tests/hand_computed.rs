@@ -489,3 +489,57 @@ height = 1
         assert_pixel(&render_both(&custom), 0, 0, expected);
     }
 }
+
+/// SPEC §2: a term of zero weight is not computed. One ball fills a 3×3 view, lit from
+/// behind the camera: with `(1 − w_t)(1 − w_r) = 0` (a perfect mirror, clear glass, or
+/// both weights high) no pixel casts a shadow ray; otherwise every pixel's hit does.
+/// No reflected ray when `w_r = 0` and no transmitted one when `w_t = 0`: then the
+/// primary hits cast no secondary rays at all.
+#[test]
+fn terms_of_zero_weight_cast_no_rays() {
+    for (reflect, transmit, local) in [
+        (1.0, 0.0, false),
+        (0.0, 1.0, false),
+        (1.0, 0.5, false),
+        (0.5, 1.0, false),
+        (0.5, 0.5, true),
+        (0.0, 0.0, true),
+    ] {
+        let toml = format!(
+            "{CAMERA}
+[image]
+width = 3
+height = 3
+
+[[light]]
+position = [0, 0, 10]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 2.5
+reflect = {reflect}
+transmit = {transmit}
+"
+        );
+        let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+        for precision in [Precision::Fast, Precision::Reference] {
+            let mut opts = scene.settings();
+            opts.quality.precision = precision;
+            let (_, stats) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+            let case = format!("w_r {reflect}, w_t {transmit}, {precision:?}");
+            assert_eq!(stats.rays.primary, 9, "{case}");
+            // Every primary ray hits the ball, whose front faces the light.
+            let shadow = stats.rays.shadow;
+            if local {
+                assert!(shadow >= 9, "{case}: {shadow} shadow rays");
+            } else {
+                assert_eq!(shadow, 0, "{case}");
+            }
+            if reflect == 0.0 && transmit == 0.0 {
+                assert_eq!(stats.rays.secondary, 0, "{case}");
+            } else {
+                assert!(stats.rays.secondary >= 9, "{case}");
+            }
+        }
+    }
+}
