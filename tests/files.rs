@@ -11,7 +11,7 @@ use std::path::Path;
 use std::process::Command;
 
 use image::{Rgb32FImage, RgbImage};
-use whitted::image_io::{self, Encoding, Format};
+use whitted::image_io::{self, Encoding, Format, UnknownFormat};
 use whitted::render::{self, Frame, RenderControl};
 use whitted::scene::{hw3_scene, HW3_DEFAULT_SEED};
 
@@ -251,7 +251,10 @@ fn format_follows_the_extension() {
     assert_eq!(f("a.jpeg"), Ok(Format::Jpeg));
     assert_eq!(f("a.exr"), Ok(Format::Exr));
     assert!(f("a.gif").unwrap_err().to_string().contains("a.gif"));
-    assert!(f("noextension").is_err());
+    assert_eq!(
+        f("noextension"),
+        Err(UnknownFormat(Path::new("noextension").to_path_buf()))
+    );
 }
 
 #[test]

@@ -150,6 +150,21 @@ fn total_internal_reflection_beyond_the_critical_angle() {
     assert!(crosses && t.y > 0.0 && (t.x - 1.5 * theta.sin()).abs() < 1e-12);
 }
 
+/// Exactly at the critical angle `k = 0`, and SPEC §2 calls only `k < 0` total internal
+/// reflection: the ray leaves along the surface. With `cos i = 1/2` (an exact dot
+/// product) and `ior = √(4/3)` (whose square times 3/4 rounds to exactly 1 in `f64`),
+/// `k = 1 − ior²·(1 − 1/4)` is exactly 0 and the direction is `ior·d + (ior/2)·N`,
+/// which is `(ior·√¾, 0, 0)`: along +x.
+#[test]
+fn at_exactly_the_critical_angle_the_ray_leaves_along_the_surface() {
+    let ior = (4.0f64 / 3.0).sqrt();
+    assert_eq!(1.0 - ior * ior * (1.0 - 0.5 * 0.5), 0.0, "k is exactly 0");
+    let d = DVec3::new(0.75f64.sqrt(), 0.5, 0.0);
+    let (t, crosses) = model::transmit(d, DVec3::Y, false, ior);
+    assert!(crosses, "k = 0 is not total internal reflection");
+    assert!(close(t, DVec3::X, 1e-15), "{t}");
+}
+
 #[test]
 fn shadow_factor_of_an_occluder() {
     let l = DVec3::Z;
@@ -472,5 +487,59 @@ height = 1
         let t = 0.5 * (y + 1.0);
         let expected = DVec3::new(0.2, 0.4, 0.6) * (1.0 - t) + DVec3::new(1.0, 0.0, 0.5) * t;
         assert_pixel(&render_both(&custom), 0, 0, expected);
+    }
+}
+
+/// SPEC §2: a term of zero weight is not computed. One ball fills a 3×3 view, lit from
+/// behind the camera: with `(1 − w_t)(1 − w_r) = 0` (a perfect mirror, clear glass, or
+/// both weights high) no pixel casts a shadow ray; otherwise every pixel's hit does.
+/// No reflected ray when `w_r = 0` and no transmitted one when `w_t = 0`: then the
+/// primary hits cast no secondary rays at all.
+#[test]
+fn terms_of_zero_weight_cast_no_rays() {
+    for (reflect, transmit, local) in [
+        (1.0, 0.0, false),
+        (0.0, 1.0, false),
+        (1.0, 0.5, false),
+        (0.5, 1.0, false),
+        (0.5, 0.5, true),
+        (0.0, 0.0, true),
+    ] {
+        let toml = format!(
+            "{CAMERA}
+[image]
+width = 3
+height = 3
+
+[[light]]
+position = [0, 0, 10]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 2.5
+reflect = {reflect}
+transmit = {transmit}
+"
+        );
+        let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+        for precision in [Precision::Fast, Precision::Reference] {
+            let mut opts = scene.settings();
+            opts.quality.precision = precision;
+            let (_, stats) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+            let case = format!("w_r {reflect}, w_t {transmit}, {precision:?}");
+            assert_eq!(stats.rays.primary, 9, "{case}");
+            // Every primary ray hits the ball, whose front faces the light.
+            let shadow = stats.rays.shadow;
+            if local {
+                assert!(shadow >= 9, "{case}: {shadow} shadow rays");
+            } else {
+                assert_eq!(shadow, 0, "{case}");
+            }
+            if reflect == 0.0 && transmit == 0.0 {
+                assert_eq!(stats.rays.secondary, 0, "{case}");
+            } else {
+                assert!(stats.rays.secondary >= 9, "{case}");
+            }
+        }
     }
 }

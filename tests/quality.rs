@@ -2,15 +2,22 @@
 //! the presets, each checked against an independent render (no cutoff, full
 //! anti-aliasing, the f64 reference).
 
+mod support;
+
 use glam::{DVec3, Vec3};
 use proptest::prelude::*;
+use support::spec_reference::{check_close, spec_reference};
+use whitted::image_io::{to_rgb8, Encoding};
 
 use whitted::render::{
     accumulate, first_pass_samples, make_tracer, render, render_bounded, resolve, RenderControl,
+    RenderError,
 };
 use whitted::sampling::sample_offset;
 use whitted::scene::{hw3_scene, Light, Scene, Sphere};
-use whitted::settings::{Adaptive, Overrides, Precision, Preset, Quality, Region, Settings};
+use whitted::settings::{
+    Adaptive, Overrides, Precision, Preset, Quality, Region, Settings, SettingsError,
+};
 
 /// A layer of settings that names only a preset.
 fn preset(p: Preset) -> Overrides {
@@ -263,7 +270,16 @@ fn every_preset_renders_and_better_presets_err_less() {
         errors.push(sq);
         assert_eq!(p.name().parse::<Preset>(), Ok(p));
     }
-    assert_eq!(errors[3], 0.0, "the reference preset is the reference");
+    // The reference preset's image is the SPEC's `f64` image of its settings, made
+    // without the renderer's film mapping, sample loop or bytes.
+    let opts = base.clone().with(&preset(Preset::Reference));
+    let bytes = to_rgb8(&reference, Encoding::Linear).into_raw();
+    check_close(
+        "reference preset, 32x18",
+        &bytes,
+        &spec_reference(&scene, &opts),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
 }
 
@@ -275,16 +291,21 @@ fn unknown_preset_and_bad_knobs_are_clear_errors() {
         "{e}"
     );
     let (scene, mut opts) = hw3_opts(8, 8, 1);
+    let refused = |opts: &Settings| match render(&scene, opts, &RenderControl::default()) {
+        Err(RenderError::Settings(e)) => e,
+        Err(e) => panic!("refused for another reason: {e}"),
+        Ok(_) => panic!("rendered {:?}", opts.quality),
+    };
     opts.quality.cutoff = f32::NAN;
-    assert!(render(&scene, &opts, &RenderControl::default()).is_err());
+    assert!(matches!(refused(&opts), SettingsError::Cutoff(c) if c.is_nan()));
     opts.quality.cutoff = 0.0;
     opts.quality.adaptive = Some(Adaptive {
         first: 0,
         threshold: 0.1,
     });
-    assert!(render(&scene, &opts, &RenderControl::default()).is_err());
+    assert_eq!(refused(&opts), SettingsError::AdaptiveFirst);
     opts.quality.adaptive = Some(Adaptive::with_threshold(-1.0));
-    assert!(render(&scene, &opts, &RenderControl::default()).is_err());
+    assert_eq!(refused(&opts), SettingsError::AdaptiveThreshold(-1.0));
 }
 
 #[test]

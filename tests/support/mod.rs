@@ -4,6 +4,8 @@
 //! samples before they are zeroed; and proptest's seeded runner and strategies.
 #![allow(dead_code)]
 
+pub mod spec_reference;
+
 use std::path::PathBuf;
 
 use glam::{DVec3, Vec3};
@@ -334,7 +336,7 @@ pub fn stress_text(s: &Stress) -> String {
 }
 
 /// A render's 8-bit image (top row first) and how many samples were not finite before
-/// `render::resolve` zeroed them.
+/// `render::resolve` zeroed them (for the reference, before `spec_reference` did).
 pub struct Rendered {
     pub rgb: Vec<u8>,
     pub non_finite: usize,
@@ -348,8 +350,17 @@ pub fn render_with(scene: &Scene, width: u32, height: u32, renderer: Precision) 
     opts.quality.spp = 1;
     opts.quality.precision = renderer;
     opts.check().expect("valid options");
-    let control = RenderControl::default();
     let start = std::time::Instant::now();
+    if renderer == Precision::Reference {
+        // The reference's image by the SPEC's formulas, not the renderer's.
+        let image = spec_reference::spec_reference(scene, &opts);
+        return Rendered {
+            rgb: image.rgb,
+            non_finite: image.non_finite,
+            seconds: start.elapsed().as_secs_f64(),
+        };
+    }
+    let control = RenderControl::default();
     let tracer = render::make_tracer(scene, &opts).expect("a tracer");
     let mut sums = vec![Vec3::ZERO; (width * height) as usize];
     render::accumulate(tracer.as_ref(), &opts, 0..1, &mut sums, &control).expect("rendered");
