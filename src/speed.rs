@@ -239,10 +239,15 @@ impl SecondaryWalk {
                     (f64::from(x) + 0.5) / f64::from(width),
                     (f64::from(y) + 0.5) / f64::from(height),
                 );
-                let dir = (camera.lower_left + camera.horizontal * s + camera.vertical * t
-                    - camera.origin)
-                    .normalize()
-                    .as_vec3();
+                let corner = camera.lower_left - camera.origin;
+                let dir = crate::model::primary_direction(
+                    corner,
+                    camera.horizontal,
+                    camera.vertical,
+                    s,
+                    t,
+                )
+                .as_vec3();
                 let primary = Query {
                     origin: camera.origin,
                     dir,
