@@ -4,20 +4,22 @@
 //! sphere tests decide.
 
 use arrayvec::ArrayVec;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
+use rayon::prelude::*;
 use wide::{f32x4, CmpGe, CmpLe};
 
-/// An axis-aligned box.
+/// An axis-aligned box, in SIMD lanes: the build's `min` and `max` of boxes are one
+/// instruction each (scalar `f32::min` spends four on NaN, which no box holds).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Aabb {
-    pub(super) min: Vec3,
-    pub(super) max: Vec3,
+    pub(super) min: Vec3A,
+    pub(super) max: Vec3A,
 }
 
 impl Aabb {
     pub(super) const EMPTY: Aabb = Aabb {
-        min: Vec3::splat(f32::INFINITY),
-        max: Vec3::splat(f32::NEG_INFINITY),
+        min: Vec3A::INFINITY,
+        max: Vec3A::NEG_INFINITY,
     };
 
     fn grow(&mut self, other: &Aabb) {
@@ -26,21 +28,27 @@ impl Aabb {
     }
 
     fn half_area(&self) -> f32 {
-        let e = (self.max - self.min).max(Vec3::ZERO);
+        let e = (self.max - self.min).max(Vec3A::ZERO);
         e.x * e.y + e.y * e.z + e.z * e.x
     }
 
-    fn centre(&self) -> Vec3 {
+    fn centre(&self) -> Vec3A {
         (self.min + self.max) * 0.5
     }
 }
 
-/// An item as the build moves it: its box, the box's centre and its index.
+/// An item as the build moves it: its box and its index.
 #[derive(Clone, Copy)]
 struct BuildItem {
     bounds: Aabb,
-    centre: Vec3,
     index: u32,
+}
+
+impl BuildItem {
+    #[inline]
+    fn centre(&self) -> Vec3A {
+        self.bounds.centre()
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -91,22 +99,22 @@ const MAX_SAH_DEPTH: u32 = 48;
 const STACK: usize = 320;
 
 impl Bvh {
-    /// Builds over `boxes` (one per item): a binary binned-SAH tree, then collapsed.
-    pub(super) fn build(boxes: &[Aabb]) -> Bvh {
-        // Each item's box and centre travel with it as the splits reorder the items,
-        // so every level of the build reads them in order, not from all over `boxes`.
-        let mut items: Vec<BuildItem> = boxes
-            .iter()
-            .enumerate()
-            .map(|(k, b)| BuildItem {
-                bounds: *b,
-                centre: b.centre(),
+    /// Builds over `len` items, item `k` in the box `bounds(k)`: a binary binned-SAH
+    /// tree, then collapsed.
+    pub(super) fn build(len: usize, bounds: impl Fn(usize) -> Aabb + Sync) -> Bvh {
+        // Each item's box travels with it as the splits reorder the items, so every
+        // level of the build reads them in order.
+        let mut items: Vec<BuildItem> = (0..len)
+            .into_par_iter()
+            .map(|k| BuildItem {
+                bounds: bounds(k),
                 index: k as u32,
             })
             .collect();
-        let mut binary = Vec::with_capacity(2 * boxes.len().max(1));
-        if !boxes.is_empty() {
-            build_node(&mut items, 0, 0, &mut binary);
+        let mut binary = Vec::with_capacity(2 * len.max(1));
+        if len > 0 {
+            let bounds = Bounds::of(&items);
+            build_node(&mut items, bounds, 0, 0, &mut binary);
         }
         let mut nodes = Vec::with_capacity(binary.len() / 2 + 1);
         if let Some(root) = binary.first() {
@@ -129,7 +137,7 @@ impl Bvh {
 
     /// Calls `visit(slot)` for every item (`items()[slot]`) whose box overlaps the box
     /// `[min, max]`.
-    pub(super) fn overlapping(&self, min: Vec3, max: Vec3, mut visit: impl FnMut(u32)) {
+    pub(super) fn overlapping(&self, min: Vec3A, max: Vec3A, mut visit: impl FnMut(u32)) {
         if self.nodes.is_empty() {
             return;
         }
@@ -324,17 +332,79 @@ fn node4(binary: &[Node], children: &[usize]) -> Node4 {
     }
 }
 
-fn build_node(items: &mut [BuildItem], first: u32, depth: u32, nodes: &mut Vec<Node>) -> u32 {
-    let mut bounds = Aabb::EMPTY;
-    let mut centre_bounds = Aabb::EMPTY;
-    for item in items.iter() {
-        bounds.grow(&item.bounds);
-        let c = item.centre;
-        centre_bounds.grow(&Aabb { min: c, max: c });
+/// The box of a set of items and the box of their centres.
+#[derive(Clone, Copy)]
+struct Bounds {
+    boxes: Aabb,
+    centres: Aabb,
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds {
+        boxes: Aabb::EMPTY,
+        centres: Aabb::EMPTY,
+    };
+
+    fn of(items: &[BuildItem]) -> Bounds {
+        let mut b = Bounds::EMPTY;
+        items.iter().for_each(|item| b.add(item));
+        b
     }
+
+    #[inline]
+    fn add(&mut self, item: &BuildItem) {
+        self.boxes.grow(&item.bounds);
+        let c = item.centre();
+        self.centres.min = self.centres.min.min(c);
+        self.centres.max = self.centres.max.max(c);
+    }
+
+    fn grow(&mut self, other: &Bounds) {
+        self.boxes.grow(&other.boxes);
+        self.centres.grow(&other.centres);
+    }
+}
+
+/// A split of a node's items: those in bins `..=last_left` on `axis` go left. The
+/// bounds of both sides come from the bins, so no child measures its items again.
+struct Split {
+    axis: usize,
+    /// The bin of a centre coordinate `x` is `((x − lo)·scale)`, at most `BINS − 1`.
+    lo: f32,
+    scale: f32,
+    last_left: usize,
+    left: Bounds,
+    right: Bounds,
+}
+
+impl Split {
+    /// `bin_of(x) <= last_left` without the cast: the bin is the integer part of
+    /// `(x − lo)·scale` (0 for NaN), and `last_left < BINS − 1`.
+    #[inline]
+    fn goes_left(&self, item: &BuildItem) -> bool {
+        let at = (item.centre()[self.axis] - self.lo) * self.scale;
+        !(at >= (self.last_left + 1) as f32)
+    }
+}
+
+/// The bin of centre coordinate `x` (`x ≥ lo`).
+#[inline]
+fn bin_of(x: f32, lo: f32, scale: f32) -> usize {
+    // Through i32, whose conversion costs fewer instructions than usize's.
+    (((x - lo) * scale) as i32).clamp(0, BINS as i32 - 1) as usize
+}
+
+/// Builds the binary subtree over `items`, whose bounds are `bounds`; returns its index.
+fn build_node(
+    items: &mut [BuildItem],
+    bounds: Bounds,
+    first: u32,
+    depth: u32,
+    nodes: &mut Vec<Node>,
+) -> u32 {
     let me = nodes.len() as u32;
     nodes.push(Node {
-        bounds,
+        bounds: bounds.boxes,
         index: first,
         count: items.len() as u32,
         axis: 0,
@@ -343,36 +413,34 @@ fn build_node(items: &mut [BuildItem], first: u32, depth: u32, nodes: &mut Vec<N
         return me;
     }
     let sah = if depth < MAX_SAH_DEPTH {
-        best_split(items, &centre_bounds, &bounds)
+        best_split(items, &bounds)
     } else {
         None
     };
-    // Otherwise a split by count (at NaN nothing goes left, so the count split below
-    // applies): deep in the tree, so that the depth stays within the stack, and for a
-    // set too large for a leaf (spheres with one centre); else a leaf.
+    // Otherwise a split by count: deep in the tree, so that the depth stays within the
+    // stack, and for a set too large for a leaf (spheres with one centre); else a leaf.
     let by_count = depth >= MAX_SAH_DEPTH || items.len() > LARGEST_LEAF;
-    let split = sah.or_else(|| {
-        let axis = (centre_bounds.max - centre_bounds.min).max_position();
-        by_count.then_some((axis, f32::NAN))
-    });
-    let Some((axis, split)) = split else {
-        return me; // no split beats a leaf
+    let (axis, mid, left, right) = match sah {
+        Some(split) => {
+            let mid = partition(items, |item| split.goes_left(item));
+            (split.axis, mid, split.left, split.right)
+        }
+        None if by_count => {
+            let axis = (bounds.centres.max - bounds.centres.min).max_position();
+            items.sort_unstable_by(|a, b| a.centre()[axis].total_cmp(&b.centre()[axis]));
+            let mid = items.len() / 2;
+            let (l, r) = items.split_at(mid);
+            (axis, mid, Bounds::of(l), Bounds::of(r))
+        }
+        None => return me, // no split beats a leaf
     };
-    let mid = partition(items, |item| item.centre[axis] < split);
-    // Degenerate partitions (all centres equal on the axis) split by count.
-    let mid = if mid == 0 || mid == items.len() {
-        items.sort_unstable_by(|a, b| a.centre[axis].total_cmp(&b.centre[axis]));
-        items.len() / 2
-    } else {
-        mid
-    };
-    let (left, right) = items.split_at_mut(mid);
-    let right_index = if items_len_is_large(left.len() + right.len()) {
+    let (left_items, right_items) = items.split_at_mut(mid);
+    let right_index = if items_len_is_large(left_items.len() + right_items.len()) {
         // Big subtrees build on two threads, into their own vectors, then splice.
         let (mut l, mut r) = (Vec::new(), Vec::new());
         rayon::join(
-            || build_node(left, first, depth + 1, &mut l),
-            || build_node(right, first + mid as u32, depth + 1, &mut r),
+            || build_node(left_items, left, first, depth + 1, &mut l),
+            || build_node(right_items, right, first + mid as u32, depth + 1, &mut r),
         );
         let base = nodes.len() as u32;
         nodes.extend(l.into_iter().map(|n| offset(n, base)));
@@ -380,8 +448,8 @@ fn build_node(items: &mut [BuildItem], first: u32, depth: u32, nodes: &mut Vec<N
         nodes.extend(r.into_iter().map(|n| offset(n, right_base)));
         right_base
     } else {
-        build_node(left, first, depth + 1, nodes);
-        build_node(right, first + mid as u32, depth + 1, nodes)
+        build_node(left_items, left, first, depth + 1, nodes);
+        build_node(right_items, right, first + mid as u32, depth + 1, nodes)
     };
     nodes[me as usize].index = right_index;
     nodes[me as usize].count = 0;
@@ -402,55 +470,62 @@ fn offset(mut n: Node, base: u32) -> Node {
     n
 }
 
-/// The binned-SAH split `(axis, position)`, or `None` when a leaf is cheaper.
-fn best_split(items: &[BuildItem], centre_bounds: &Aabb, bounds: &Aabb) -> Option<(usize, f32)> {
-    let mut best: Option<(f32, usize, f32)> = None;
+/// The binned-SAH split, or `None` when a leaf is cheaper (or the centres coincide).
+fn best_split(items: &[BuildItem], bounds: &Bounds) -> Option<Split> {
     // Bin along the axis where the centres spread most (a third of the work of trying
     // all three, for trees nearly as good).
-    let axis = (centre_bounds.max - centre_bounds.min).max_position();
-    {
-        let lo = centre_bounds.min[axis];
-        let hi = centre_bounds.max[axis];
-        if hi <= lo {
-            return None;
+    let centres = &bounds.centres;
+    let axis = (centres.max - centres.min).max_position();
+    let lo = centres.min[axis];
+    let hi = centres.max[axis];
+    if hi <= lo {
+        return None;
+    }
+    let scale = BINS as f32 / (hi - lo);
+    let mut bins = [Bounds::EMPTY; BINS];
+    let mut bin_count = [0u32; BINS];
+    for item in items {
+        let b = bin_of(item.centre()[axis], lo, scale);
+        bins[b].add(item);
+        bin_count[b] += 1;
+    }
+    // Sweep from the right, then from the left, evaluating the cost of each plane.
+    let mut right_bounds = [Bounds::EMPTY; BINS];
+    let mut right_count = [0u32; BINS];
+    let mut acc = Bounds::EMPTY;
+    let mut n = 0;
+    for b in (1..BINS).rev() {
+        acc.grow(&bins[b]);
+        n += bin_count[b];
+        right_bounds[b] = acc;
+        right_count[b] = n;
+    }
+    let mut best: Option<(f32, usize, Bounds)> = None;
+    let mut acc = Bounds::EMPTY;
+    let mut n = 0;
+    for b in 0..BINS - 1 {
+        acc.grow(&bins[b]);
+        n += bin_count[b];
+        if n == 0 || right_count[b + 1] == 0 {
+            continue;
         }
-        let scale = BINS as f32 / (hi - lo);
-        let mut bin_bounds = [Aabb::EMPTY; BINS];
-        let mut bin_count = [0u32; BINS];
-        for item in items {
-            let b = (((item.centre[axis] - lo) * scale) as usize).min(BINS - 1);
-            bin_bounds[b].grow(&item.bounds);
-            bin_count[b] += 1;
-        }
-        // Sweep from the right, then from the left, evaluating the cost of each plane.
-        let mut right_area = [0.0f32; BINS];
-        let mut right_count = [0u32; BINS];
-        let mut acc = Aabb::EMPTY;
-        let mut n = 0;
-        for b in (1..BINS).rev() {
-            acc.grow(&bin_bounds[b]);
-            n += bin_count[b];
-            right_area[b] = acc.half_area();
-            right_count[b] = n;
-        }
-        let mut acc = Aabb::EMPTY;
-        let mut n = 0;
-        for b in 0..BINS - 1 {
-            acc.grow(&bin_bounds[b]);
-            n += bin_count[b];
-            if n == 0 || right_count[b + 1] == 0 {
-                continue;
-            }
-            let cost = acc.half_area() * n as f32 + right_area[b + 1] * right_count[b + 1] as f32;
-            if best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, axis, lo + (b + 1) as f32 / scale));
-            }
+        let cost = acc.boxes.half_area() * n as f32
+            + right_bounds[b + 1].boxes.half_area() * right_count[b + 1] as f32;
+        if best.is_none_or(|(c, _, _)| cost < c) {
+            best = Some((cost, b, acc));
         }
     }
-    let (cost, axis, split) = best?;
+    let (cost, last_left, left) = best?;
     // A leaf costs one test per item; an inner node about one box test plus its children.
-    let leaf_cost = bounds.half_area() * items.len() as f32;
-    (cost < leaf_cost || items.len() > LARGEST_LEAF).then_some((axis, split))
+    let leaf_cost = bounds.boxes.half_area() * items.len() as f32;
+    (cost < leaf_cost || items.len() > LARGEST_LEAF).then_some(Split {
+        axis,
+        lo,
+        scale,
+        last_left,
+        left,
+        right: right_bounds[last_left + 1],
+    })
 }
 
 /// Moves the items for which `left` holds to the front; returns how many there are.
@@ -479,12 +554,12 @@ mod tests {
                 .map(|k| {
                     let r = 1.0 + k as f32;
                     Aabb {
-                        min: Vec3::splat(-r),
-                        max: Vec3::splat(r),
+                        min: Vec3A::splat(-r),
+                        max: Vec3A::splat(r),
                     }
                 })
                 .collect();
-            let bvh = Bvh::build(&boxes);
+            let bvh = Bvh::build(boxes.len(), |k| boxes[k]);
             for node in &bvh.nodes {
                 assert!(node.count.iter().all(|&c| usize::from(c) <= LARGEST_LEAF));
             }

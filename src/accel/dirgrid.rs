@@ -60,7 +60,11 @@ fn cells_of(centre: DVec3, c: DVec3, r: f64, n: u32, cones: &CellCones, k: u32, 
     }
     let sphere_cone = SphereCone::new(rel, dist, r);
     let (lo, hi) = (rel - DVec3::splat(reach), rel + DVec3::splat(reach));
-    for face in 0..6u32 {
+    let faces = match only_face(lo, hi) {
+        Some(face) => face..face + 1,
+        None => 0..6,
+    };
+    for face in faces {
         let Some([u0, u1, v0, v1]) = face_rect(face, lo, hi, n) else {
             continue;
         };
@@ -269,6 +273,29 @@ fn from_face(face: u32, f: DVec3) -> DVec3 {
 #[inline]
 fn cell_index(face: u32, u: u32, v: u32, n: u32) -> usize {
     ((face * n + v) * n + u) as usize
+}
+
+/// The one face in which the box `[lo, hi]` (relative to the centre) can be seen, when
+/// it lies well inside that face's pyramid; `None` when it may be seen in several.
+/// "Well inside" leaves every other face's [`face_rect`] empty: there the box's
+/// coordinates are beyond ±1/(1 − 2·`WIDEN`), more than `WIDEN` past the face's edge.
+fn only_face(lo: DVec3, hi: DVec3) -> Option<u32> {
+    let far = lo.abs().max(hi.abs());
+    let axis = far.max_position();
+    // The box's nearest extent along the axis, on the side it lies.
+    let near = if lo[axis] > 0.0 {
+        lo[axis]
+    } else if hi[axis] < 0.0 {
+        -hi[axis]
+    } else {
+        return None;
+    };
+    let others = match axis {
+        0 => far.y.max(far.z),
+        1 => far.x.max(far.z),
+        _ => far.x.max(far.y),
+    };
+    (others < near * (1.0 - 2.0 * WIDEN)).then(|| 2 * axis as u32 + u32::from(hi[axis] < 0.0))
 }
 
 /// The cells of `face` that the box `[lo, hi]` (relative to the centre) may be seen in,

@@ -8,7 +8,7 @@ mod point;
 
 use std::sync::OnceLock;
 
-use glam::{DVec3, Vec3, Vec4};
+use glam::{DVec3, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 use bvh::{Aabb, Bvh};
@@ -108,6 +108,33 @@ fn quick_sphere(c: DVec3, r: f64) -> Vec4 {
     c.as_vec3().extend((r + widen) as f32)
 }
 
+/// The `f32` box of a sphere in the hierarchy: widened by a little more than `f32`'s
+/// rounding of the centre and radius, and rounded outwards.
+fn sphere_box(c: DVec3, r: f64) -> Aabb {
+    let widen = r * 1e-6 + 1e-6 * c.abs().max_element();
+    let (lo, hi) = (c - DVec3::splat(r + widen), c + DVec3::splat(r + widen));
+    let down = |x: f64| {
+        let f = x as f32;
+        if f64::from(f) > x {
+            f.next_down()
+        } else {
+            f
+        }
+    };
+    let up = |x: f64| {
+        let f = x as f32;
+        if f64::from(f) < x {
+            f.next_up()
+        } else {
+            f
+        }
+    };
+    Aabb {
+        min: Vec3A::new(down(lo.x), down(lo.y), down(lo.z)),
+        max: Vec3A::new(up(hi.x), up(hi.y), up(hi.z)),
+    }
+}
+
 /// What the exact test reads of a sphere.
 #[derive(Clone, Copy)]
 struct Exact {
@@ -146,8 +173,6 @@ pub(crate) struct Spheres {
     /// inside it can meet before its far side (see [`Spheres::closest_inside`]).
     /// Worked out when a ray first goes inside the sphere: most spheres never see one.
     inside: Vec<OnceLock<Box<[u32]>>>,
-    /// Per sphere, its box as the hierarchy holds it.
-    boxes: Vec<Aabb>,
 }
 
 impl Spheres {
@@ -160,36 +185,7 @@ impl Spheres {
             .zip(&radius)
             .map(|(&c, &r)| quick_sphere(c, r))
             .collect();
-        let boxes: Vec<Aabb> = center
-            .par_iter()
-            .zip(&radius)
-            .map(|(&c, &r)| {
-                let widen = r * 1e-6 + 1e-6 * c.abs().max_element();
-                let (lo, hi) = (c - DVec3::splat(r + widen), c + DVec3::splat(r + widen));
-                // Round outwards to f32.
-                let down = |x: f64| {
-                    let f = x as f32;
-                    if f64::from(f) > x {
-                        f.next_down()
-                    } else {
-                        f
-                    }
-                };
-                let up = |x: f64| {
-                    let f = x as f32;
-                    if f64::from(f) < x {
-                        f.next_up()
-                    } else {
-                        f
-                    }
-                };
-                Aabb {
-                    min: Vec3::new(down(lo.x), down(lo.y), down(lo.z)),
-                    max: Vec3::new(up(hi.x), up(hi.y), up(hi.z)),
-                }
-            })
-            .collect();
-        let bvh = Bvh::build(&boxes);
+        let bvh = Bvh::build(spheres.len(), |k| sphere_box(center[k], radius[k]));
         let inside = (0..spheres.len()).map(|_| OnceLock::new()).collect();
         let leaf = bvh
             .items()
@@ -213,7 +209,6 @@ impl Spheres {
             quick,
             lights: Vec::new(),
             inside,
-            boxes,
         }
     }
 
@@ -410,7 +405,7 @@ impl Spheres {
     fn overlapping(&self, s: u32) -> Box<[u32]> {
         let s = s as usize;
         let (c, r) = (self.center[s], self.radius[s]);
-        let bounds = &self.boxes[s];
+        let bounds = sphere_box(c, r);
         let mut list = Vec::new();
         self.bvh.overlapping(bounds.min, bounds.max, |slot| {
             let k = self.leaf[slot as usize].k as usize;
