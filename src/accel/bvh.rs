@@ -49,6 +49,13 @@ impl BuildItem {
     fn centre(&self) -> Vec3A {
         self.bounds.centre()
     }
+
+    /// The centre's coordinate on `axis`: the same number as `centre()[axis]`, read
+    /// from memory (a lane picked at run time from a register goes through the stack).
+    #[inline]
+    fn centre_on(&self, axis: usize) -> f32 {
+        (self.bounds.min[axis] + self.bounds.max[axis]) * 0.5
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -382,7 +389,7 @@ impl Split {
     /// `(x − lo)·scale` (0 for NaN), and `last_left < BINS − 1`.
     #[inline]
     fn goes_left(&self, item: &BuildItem) -> bool {
-        let at = (item.centre()[self.axis] - self.lo) * self.scale;
+        let at = (item.centre_on(self.axis) - self.lo) * self.scale;
         !(at >= (self.last_left + 1) as f32)
     }
 }
@@ -427,7 +434,7 @@ fn build_node(
         }
         None if by_count => {
             let axis = (bounds.centres.max - bounds.centres.min).max_position();
-            items.sort_unstable_by(|a, b| a.centre()[axis].total_cmp(&b.centre()[axis]));
+            items.sort_unstable_by(|a, b| a.centre_on(axis).total_cmp(&b.centre_on(axis)));
             let mid = items.len() / 2;
             let (l, r) = items.split_at(mid);
             (axis, mid, Bounds::of(l), Bounds::of(r))
@@ -485,7 +492,7 @@ fn best_split(items: &[BuildItem], bounds: &Bounds) -> Option<Split> {
     let mut bins = [Bounds::EMPTY; BINS];
     let mut bin_count = [0u32; BINS];
     for item in items {
-        let b = bin_of(item.centre()[axis], lo, scale);
+        let b = bin_of(item.centre_on(axis), lo, scale);
         bins[b].add(item);
         bin_count[b] += 1;
     }
@@ -529,15 +536,24 @@ fn best_split(items: &[BuildItem], bounds: &Bounds) -> Option<Split> {
 }
 
 /// Moves the items for which `left` holds to the front; returns how many there are.
+/// From both ends, swapping only the items on the wrong side: a pass over a large
+/// node writes the few it moves, not every left item.
 fn partition(items: &mut [BuildItem], left: impl Fn(&BuildItem) -> bool) -> usize {
-    let mut mid = 0;
-    for k in 0..items.len() {
-        if left(&items[k]) {
-            items.swap(k, mid);
-            mid += 1;
+    let (mut i, mut j) = (0, items.len());
+    loop {
+        while i < j && left(&items[i]) {
+            i += 1;
         }
+        while i < j && !left(&items[j - 1]) {
+            j -= 1;
+        }
+        if i >= j {
+            return i;
+        }
+        items.swap(i, j - 1);
+        i += 1;
+        j -= 1;
     }
-    mid
 }
 
 #[cfg(test)]
