@@ -69,31 +69,36 @@ struct Node {
     axis: u32,
 }
 
-/// The tree as the queries use it: four children per node, their boxes side by side
-/// so that one SIMD test checks all four.
+/// The tree as the queries use it: [`WIDTH`] children per node, their boxes side by
+/// side so that SIMD tests check four at once.
 pub(super) struct Bvh {
-    nodes: Vec<Node4>,
+    nodes: Vec<WideNode>,
     /// Item indices in leaf order.
     items: Vec<u32>,
 }
 
-/// A node of the 4-wide tree: child boxes as four lanes per coordinate. Aligned to two
-/// cache lines exactly, so that reading a node touches two lines, never three.
+/// Children per node of the tree the queries walk.
+const WIDTH: usize = 8;
+/// Groups of four lanes per node.
+const GROUPS: usize = WIDTH / 4;
+
+/// A node of the wide tree: child boxes as lanes per coordinate, four to a group.
+/// Aligned to cache lines, so that reading a node touches `WIDTH / 2` lines exactly.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct Node4 {
-    min: [f32x4; 3],
-    max: [f32x4; 3],
+struct WideNode {
+    min: [[f32x4; GROUPS]; 3],
+    max: [[f32x4; GROUPS]; 3],
     /// Per child: the node index (inner) or the first item (leaf).
-    child: [u32; 4],
+    child: [u32; WIDTH],
     /// Per child: 0 for an inner node, else the number of items of the leaf (at most
     /// [`LARGEST_LEAF`]).
-    count: [u8; 4],
+    count: [u8; WIDTH],
     /// Lanes that hold a child.
     used: u8,
 }
 
-const _: () = assert!(std::mem::size_of::<Node4>() == 128);
+const _: () = assert!(std::mem::size_of::<WideNode>() == 32 * WIDTH);
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
@@ -102,8 +107,9 @@ const MAX_LEAF: usize = 4;
 const LARGEST_LEAF: usize = 16;
 /// Depth after which splits are by count: keeps any tree below `STACK` levels.
 const MAX_SAH_DEPTH: u32 = 48;
-/// Four entries a level (children of every node on the path) and then some.
-const STACK: usize = 320;
+/// `WIDTH − 1` waiting entries a level (siblings of every node on the path) for a path
+/// of up to 100 levels, and then some.
+const STACK: usize = WIDTH * 100;
 
 impl Bvh {
     /// Builds over `len` items, item `k` in the box `bounds(k)`: a binary binned-SAH
@@ -127,7 +133,7 @@ impl Bvh {
         if let Some(root) = binary.first() {
             if root.count > 0 {
                 // A single leaf: wrap it in a node of one child.
-                nodes.push(node4(&binary, &[0]));
+                nodes.push(wide_node(&binary, &[0]));
             } else {
                 collapse(&binary, 0, &mut nodes);
             }
@@ -155,10 +161,15 @@ impl Bvh {
         stack.push(0);
         while let Some(index) = stack.pop() {
             let n = &self.nodes[index as usize];
-            let mut hit = u32::from(n.used);
-            for a in 0..3 {
-                hit &= (n.min[a].cmp_le(hi[a]) & n.max[a].cmp_ge(lo[a])).move_mask() as u32;
+            let mut hit = 0;
+            for g in 0..GROUPS {
+                let mut h = u32::MAX;
+                for a in 0..3 {
+                    h &= (n.min[a][g].cmp_le(hi[a]) & n.max[a][g].cmp_ge(lo[a])).move_mask() as u32;
+                }
+                hit |= (h & 0xf) << (4 * g);
             }
+            hit &= u32::from(n.used);
             while hit != 0 {
                 let lane = hit.trailing_zeros() as usize;
                 hit &= hit - 1;
@@ -215,22 +226,27 @@ impl Bvh {
                 continue;
             }
             let n = &self.nodes[index as usize];
-            let mut near = f32x4::splat(0.0);
-            let mut far = f32x4::splat(t_max);
-            // No NaN can arise (finite reciprocals, never 0; boxes finite or empty,
-            // which gives ±∞), so the plain SSE min and max do: `min`/`max` of `wide`
-            // spend three more instructions each on NaN lanes.
-            for a in 0..3 {
-                let t0 = (n.min[a] - o4[a]) * inv4[a];
-                let t1 = (n.max[a] - o4[a]) * inv4[a];
-                near = near.fast_max(t0.fast_min(t1));
-                far = far.fast_min(t0.fast_max(t1));
+            let mut hit = 0;
+            let mut near = [0.0f32; WIDTH];
+            for g in 0..GROUPS {
+                let mut near4 = f32x4::splat(0.0);
+                let mut far4 = f32x4::splat(t_max);
+                // No NaN can arise (finite reciprocals, never 0; boxes finite or empty,
+                // which gives ±∞), so the plain SSE min and max do: `min`/`max` of
+                // `wide` spend three more instructions each on NaN lanes.
+                for a in 0..3 {
+                    let t0 = (n.min[a][g] - o4[a]) * inv4[a];
+                    let t1 = (n.max[a][g] - o4[a]) * inv4[a];
+                    near4 = near4.fast_max(t0.fast_min(t1));
+                    far4 = far4.fast_min(t0.fast_max(t1));
+                }
+                hit |= (near4.cmp_le(far4).move_mask() as u32) << (4 * g);
+                near[4 * g..4 * g + 4].copy_from_slice(&near4.to_array());
             }
-            let hit = (near.cmp_le(far).move_mask() as u32) & u32::from(n.used);
+            hit &= u32::from(n.used);
             if hit == 0 {
                 continue;
             }
-            let near = near.to_array();
             // Children onto the stack farthest first, leaves and inner nodes alike: the
             // nearest comes off first, so hits are found nearest first and prune the
             // rest (visiting leaves at once would find farther hits first, each a
@@ -256,7 +272,7 @@ impl Bvh {
                 push(&mut stack, near_lane);
                 continue;
             }
-            let mut order = [first, second, 0, 0];
+            let mut order = [first, second, 0, 0, 0, 0, 0, 0];
             let mut k = 2;
             let mut more = rest & (rest - 1);
             while more != 0 {
@@ -265,8 +281,8 @@ impl Bvh {
                 k += 1;
             }
             let order = &mut order[..k];
-            // Insertion sort, farthest first: at most four lanes (a library sort is not
-            // inlined and costs more than the node test).
+            // Insertion sort, farthest first: at most `WIDTH` lanes, rarely more than
+            // three (a library sort is not inlined and costs more than the node test).
             for a in 1..k {
                 let mut b = a;
                 while b > 0 && near[order[b - 1]] < near[order[b]] {
@@ -281,11 +297,11 @@ impl Bvh {
     }
 }
 
-/// Collapses the binary subtree at inner node `b` into 4-wide nodes; returns its index.
-fn collapse(binary: &[Node], b: usize, out: &mut Vec<Node4>) -> u32 {
-    // Open the largest inner child until there are four children.
+/// Collapses the binary subtree at inner node `b` into wide nodes; returns its index.
+fn collapse(binary: &[Node], b: usize, out: &mut Vec<WideNode>) -> u32 {
+    // Open the largest inner child until there are `WIDTH` children.
     let mut children = vec![b + 1, binary[b].index as usize];
-    while children.len() < 4 {
+    while children.len() < WIDTH {
         let open = children
             .iter()
             .enumerate()
@@ -303,7 +319,7 @@ fn collapse(binary: &[Node], b: usize, out: &mut Vec<Node4>) -> u32 {
         children.push(binary[c].index as usize);
     }
     let me = out.len() as u32;
-    out.push(node4(binary, &children));
+    out.push(wide_node(binary, &children));
     for (lane, &c) in children.iter().enumerate() {
         if binary[c].count == 0 {
             let index = collapse(binary, c, out);
@@ -313,12 +329,12 @@ fn collapse(binary: &[Node], b: usize, out: &mut Vec<Node4>) -> u32 {
     me
 }
 
-/// A 4-wide node over the binary nodes `children` (inner children get their index later).
-fn node4(binary: &[Node], children: &[usize]) -> Node4 {
-    let mut min = [[f32::INFINITY; 4]; 3];
-    let mut max = [[f32::NEG_INFINITY; 4]; 3];
-    let mut child = [0u32; 4];
-    let mut count = [0u8; 4];
+/// A wide node over the binary nodes `children` (inner children get their index later).
+fn wide_node(binary: &[Node], children: &[usize]) -> WideNode {
+    let mut min = [[f32::INFINITY; WIDTH]; 3];
+    let mut max = [[f32::NEG_INFINITY; WIDTH]; 3];
+    let mut child = [0u32; WIDTH];
+    let mut count = [0u8; WIDTH];
     let mut used = 0u8;
     for (lane, &c) in children.iter().enumerate() {
         let n = &binary[c];
@@ -330,9 +346,12 @@ fn node4(binary: &[Node], children: &[usize]) -> Node4 {
         count[lane] = u8::try_from(n.count).expect("leaves hold at most LARGEST_LEAF items");
         used |= 1 << lane;
     }
-    Node4 {
-        min: min.map(f32x4::from),
-        max: max.map(f32x4::from),
+    let groups = |lanes: [f32; WIDTH]| -> [f32x4; GROUPS] {
+        std::array::from_fn(|g| f32x4::new(std::array::from_fn(|i| lanes[4 * g + i])))
+    };
+    WideNode {
+        min: min.map(groups),
+        max: max.map(groups),
         child,
         count,
         used,
