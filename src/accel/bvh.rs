@@ -409,7 +409,7 @@ impl Split {
     #[inline]
     fn goes_left(&self, item: &BuildItem) -> bool {
         let at = (item.centre_on(self.axis) - self.lo) * self.scale;
-        !(at >= (self.last_left + 1) as f32)
+        at < (self.last_left + 1) as f32 || at.is_nan()
     }
 }
 
