@@ -435,6 +435,12 @@ impl Soak<'_> {
 
     /// Memory with the window at [`MEMORY_SIZE`] and its image complete.
     fn settled_memory(&mut self) -> f64 {
+        if self.animated {
+            // A step pauses the animation, which the storm's P may have left playing
+            // (then the viewer never goes idle).
+            self.xdotool(&["key", "period"]);
+            self.figures.events += 1;
+        }
         if self.size() != MEMORY_SIZE {
             self.resize(MEMORY_SIZE);
         }
@@ -614,11 +620,8 @@ fn soak(name: &str, seconds: f64, first_part: f64) -> Option<Figures> {
 
     soak.storm(seconds, first_part);
 
-    // The storm is over: pause an animation (a step pauses it), come to rest at a
-    // size of the window, save, and compare.
-    if soak.animated {
-        soak.xdotool(&["key", "period"]);
-    }
+    // The storm is over: come to rest (an animation paused) at a size of the window,
+    // save, and compare.
     soak.figures.rss_end_mib = soak.settled_memory();
     let size = {
         let w = 64 + soak.rng.next_u32() % 700;
