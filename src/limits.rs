@@ -22,5 +22,10 @@ pub const MAX_FILE_BYTES: u64 = 1 << 28;
 /// the text); larger files must end in a run of `[[sphere]]` tables, which is parsed a
 /// batch of tables at a time.
 pub const MAX_WHOLE_PARSE_BYTES: u64 = 1 << 24;
+/// Bytes of pixels one byte of a PNG or EXR file can hold at most: deflate's largest
+/// expansion (1032:1), which no other compression that `png` and `exr` read exceeds.
+/// A header that states more pixels than its file can hold is refused before they are
+/// allocated.
+pub const MAX_EXPANSION: u64 = 1032;
 /// Frames of an animation.
 pub const MAX_FRAMES: u32 = 1 << 20;

@@ -5,8 +5,12 @@
 
 mod common;
 
+use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::{Path, PathBuf};
 use std::process::Output;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use whitted::image_io::Format;
 
 use common::run as whitted;
 
@@ -297,5 +301,143 @@ fn a_record_of_an_image_no_render_makes_is_refused() {
         let record = format!("region=0,0,1,1 image={image} id=0");
         let p: Placement = record.parse().unwrap();
         assert_eq!(p.to_string().parse(), Ok(p));
+    }
+}
+
+/// The largest single allocation this test process has made since [`Largest::reset`]:
+/// reading a part must not allocate what its header claims before the file shows it
+/// holds that much.
+struct Largest;
+
+static LARGEST: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: every call goes to the system allocator unchanged; only the size is noted.
+unsafe impl GlobalAlloc for Largest {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        LARGEST.fetch_max(layout.size(), Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        LARGEST.fetch_max(layout.size(), Ordering::Relaxed);
+        unsafe { System.alloc_zeroed(layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        LARGEST.fetch_max(new_size, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Largest = Largest;
+
+/// A part of one pixel whose header and record state a 16384×16384 part of a
+/// 16384×16384 image (what a render of `MAX_PIXELS` pixels makes).
+fn lying_part(format: Format) -> Vec<u8> {
+    use whitted::image_io::parts::{encode_part, Placement};
+    use whitted::settings::{Encoding, Region};
+    let side = 16384u32;
+    let placement = Placement {
+        region: Region {
+            x: 0,
+            y: 0,
+            width: side,
+            height: side,
+        },
+        width: side,
+        height: side,
+        image: 0,
+        encoding: Encoding::Linear,
+    };
+    let frame = whitted::render::Frame::new(1, 1);
+    let mut bytes = encode_part(&frame, &placement, format, Encoding::Linear).unwrap();
+    let (w, h) = (side.to_be_bytes(), side.to_be_bytes());
+    match format {
+        Format::Png => {
+            // IHDR's width and height, then its CRC (of the chunk's type and data).
+            assert_eq!(&bytes[12..16], b"IHDR");
+            bytes[16..20].copy_from_slice(&w);
+            bytes[20..24].copy_from_slice(&h);
+            let crc = crc32fast::hash(&bytes[12..29]);
+            bytes[29..33].copy_from_slice(&crc.to_be_bytes());
+        }
+        _ => {
+            // The data window (box2i: x and y min, then max, little-endian).
+            let name = b"dataWindow\0box2i\0";
+            let at = bytes.windows(name.len()).position(|w| w == name).unwrap();
+            let max = at + name.len() + 4 + 8;
+            let last = (side as i32 - 1).to_le_bytes();
+            bytes[max..max + 4].copy_from_slice(&last);
+            bytes[max + 4..max + 8].copy_from_slice(&last);
+        }
+    }
+    bytes
+}
+
+/// A part of a few hundred bytes whose header states 16384×16384 pixels is refused
+/// before they are allocated (805 MB for a PNG part, 3.2 GB for an EXR part were
+/// allocated before its data was found short), by `stitch` and by `compare`, with one
+/// line; a file large enough to hold its pixels still reads.
+#[test]
+fn a_part_whose_header_states_more_than_its_file_holds_is_refused_unallocated() {
+    use std::io::Cursor;
+    use whitted::image_io::parts::{decode_part, encode_part, Placement};
+    use whitted::settings::Encoding;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (format, ext) in [(Format::Png, "png"), (Format::Exr, "exr")] {
+        let bytes = lying_part(format);
+        let len = bytes.len();
+        LARGEST.store(0, Ordering::SeqCst);
+        let error = decode_part(Cursor::new(&bytes), format, "lying").unwrap_err();
+        let largest = LARGEST.load(Ordering::SeqCst);
+        let expected = format!("16384x16384 pixels, more than its {len} bytes can hold");
+        assert!(error.to_string().contains(&expected), "{ext}: {error}");
+        assert!(
+            largest < 1 << 24,
+            "{ext}: {largest} bytes allocated at once"
+        );
+        // What `compare` reads (`image` refuses an EXR without the chunks its header
+        // calls for before it allocates the pixels).
+        LARGEST.store(0, Ordering::SeqCst);
+        let limits = image::Limits::default();
+        let error = whitted::image_io::decode_image(Cursor::new(&bytes), None, limits).unwrap_err();
+        let largest = LARGEST.load(Ordering::SeqCst);
+        if format == Format::Png {
+            assert!(error.to_string().contains(&expected), "{ext}: {error}");
+        }
+        assert!(
+            largest < 1 << 24,
+            "{ext}: {largest} bytes allocated at once"
+        );
+
+        let part = path(d, &format!("lying.{ext}"));
+        std::fs::write(&part, &bytes).unwrap();
+        let out = path(d, &format!("out.{ext}"));
+        fails(&["stitch", "-o", &out, &part], 1, &expected);
+        assert!(!Path::new(&out).exists());
+        let needle = if format == Format::Png {
+            &expected
+        } else {
+            "lying.exr"
+        };
+        fails(&["compare", &part, &part], 1, needle);
+    }
+    // A real part is never refused, however well it compresses: a black one.
+    let side = 2048;
+    let placement: Placement = format!("region=0,0,{side},{side} image={side}x{side} id=0")
+        .parse()
+        .unwrap();
+    let black = whitted::render::Frame::new(side, side);
+    for format in [Format::Png, Format::Exr] {
+        let bytes = encode_part(&black, &placement, format, Encoding::Linear).unwrap();
+        let part = decode_part(Cursor::new(&bytes), format, "black")
+            .unwrap_or_else(|e| panic!("{} bytes: {e}", bytes.len()));
+        assert_eq!(part.placement, placement);
     }
 }

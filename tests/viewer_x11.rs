@@ -13,7 +13,7 @@ mod common;
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use image::RgbImage;
 
@@ -512,5 +512,86 @@ fn without_xdg_runtime_dir_the_window_says_nothing_of_it() {
             line.starts_with("whitted: ") || line.starts_with("stats: "),
             "a line not in whitted's voice: {line}"
         );
+    }
+}
+
+/// SIGTERM or SIGHUP while `S` writes a large image: the viewer exits with status 1
+/// and one line, leaves no temporary file, and every image in its folder decodes whole
+/// (the save finished before the signal is kept; the one it interrupts is either
+/// whole or absent).
+#[test]
+fn a_signal_during_a_save_leaves_only_whole_files() {
+    for signal in ["TERM", "HUP"] {
+        signal_during_a_save(signal);
+    }
+}
+
+fn signal_during_a_save(signal: &str) {
+    let test = format!("SIG{signal} during a save");
+    if !x_tools_or_skip(&test) {
+        return;
+    }
+    let x = XServer::start_with_screen(2560, 1440);
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let scene = small_scene(dir, 1);
+    let (mut viewer, window) = start_viewer(&x, dir, &scene, "softbuffer");
+    x.wait_title(&mut viewer, &window, |t| t.ends_with("- done"));
+    x.key(&window, "s");
+    viewer.wait_stdout("saved small-001.png and small-001.ppm");
+
+    // At 2560×1440 the plain PPM alone is 30 MB: writing takes a while.
+    x.xdotool(&["windowsize", &window, "2560", "1440"]);
+    x.wait_title(&mut viewer, &window, |t| {
+        t.contains(" 2560x1440 ") && t.ends_with("- done")
+    });
+    x.key(&window, "s");
+    // The signal as soon as a temporary file shows (or once the save is over).
+    let start = Instant::now();
+    let mut seen = Vec::new();
+    while start.elapsed() < Duration::from_secs(20) && !viewer.stdout().contains("small-002") {
+        seen = common::entries(dir);
+        if seen.iter().any(|n| n.ends_with(".part")) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let sent = Command::new("kill")
+        .args([&format!("-{signal}"), &viewer.child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success(), "kill -{signal}");
+    let status = wait_for("the viewer to exit", || viewer.child.try_wait().unwrap());
+    let stderr = viewer.stderr();
+    println!("SIG{signal}: {status}; folder before: {seen:?}; stderr: {stderr:?}");
+    assert_eq!(
+        status.code(),
+        Some(1),
+        "SIG{signal}: {status}; stderr:\n{stderr}"
+    );
+    assert!(
+        stderr.lines().any(|l| l == "whitted: error: interrupted"),
+        "SIG{signal}: {stderr}"
+    );
+
+    let left = common::entries(dir);
+    assert!(
+        !left
+            .iter()
+            .any(|n| n.ends_with(".part") || n.starts_with(".whitted-")),
+        "SIG{signal}: temporary files left: {left:?}"
+    );
+    let first = image::open(dir.join("small-001.png")).unwrap().to_rgb8();
+    assert_eq!(first.dimensions(), (320, 180));
+    for name in left.iter().filter(|n| n.starts_with("small-00")) {
+        let decoded = image::open(dir.join(name))
+            .unwrap_or_else(|e| panic!("SIG{signal}: {name}: {e}"))
+            .to_rgb8();
+        let expected = if name.starts_with("small-001") {
+            (320, 180)
+        } else {
+            (2560, 1440)
+        };
+        assert_eq!(decoded.dimensions(), expected, "SIG{signal}: {name}");
     }
 }

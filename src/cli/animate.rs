@@ -206,7 +206,7 @@ pub(crate) fn render_frames(
     }
     // Before the animated files are opened: a FIFO waits for its reader there.
     let control = Arc::new(RenderControl::default());
-    super::stop_on_signals(Some(Arc::clone(&control)))?;
+    super::stop_on_signals(super::cancel(&control))?;
     let mut animated = Vec::new();
     for output in &targets {
         if let Output::Animated(path, format) = output {

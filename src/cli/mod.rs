@@ -43,20 +43,25 @@ pub(crate) fn whole_number(lo: u32, hi: u32) -> impl Fn(&str) -> Result<u32, Str
     }
 }
 
-/// On Ctrl-C, SIGTERM or SIGHUP: cancels `control` (the render stops within a row
-/// of pixels) and interrupts the writing of files (none is put in place any more), so
-/// that the command ends with exit status 1 and leaves no partial file; files
+/// On Ctrl-C, SIGTERM or SIGHUP: interrupts the writing of files (none is put in
+/// place any more) and calls `stop` (which cancels the render, or closes the window),
+/// so that the command ends with exit status 1 and leaves no partial file; files
 /// complete before the signal stay.
-pub(crate) fn stop_on_signals(
-    control: Option<std::sync::Arc<whitted::render::RenderControl>>,
-) -> anyhow::Result<()> {
+pub(crate) fn stop_on_signals(stop: impl Fn() + Send + 'static) -> anyhow::Result<()> {
     ctrlc::set_handler(move || {
-        if let Some(control) = &control {
-            control.cancel();
-        }
         whitted::image_io::interrupt_writes();
+        stop();
     })
     .context("cannot install the interrupt handler")
+}
+
+/// A `stop` for [`stop_on_signals`] that cancels `control`: the render stops within
+/// a row of pixels.
+pub(crate) fn cancel(
+    control: &std::sync::Arc<whitted::render::RenderControl>,
+) -> impl Fn() + Send + 'static {
+    let control = std::sync::Arc::clone(control);
+    move || control.cancel()
 }
 
 /// The built-in scene, embedded from the file the generator wrote
@@ -82,8 +87,48 @@ pub(crate) fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
 pub(crate) fn view(path: Option<&Path>, options: Overrides) -> anyhow::Result<()> {
     let mut scene = load_scene(path)?;
     scene.image = scene.image.then(&options);
-    whitted::viewer::run(scene)
+    return_large_blocks();
+    whitted::viewer::run(
+        scene,
+        whitted::viewer::Host {
+            on_open: Box::new(|stop| stop_on_signals(move || stop.stop())),
+            release_memory,
+        },
+    )
 }
+
+/// Gives glibc's free memory back to the system (see
+/// [`whitted::viewer::Host::release_memory`]).
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn release_memory() {
+    // SAFETY: malloc_trim takes no pointers; glibc locks each arena while it trims it.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
+/// Other allocators give large freed blocks back themselves.
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn release_memory() {}
+
+/// glibc's malloc with its thresholds fixed at their defaults (128 KiB): every block
+/// from 128 KiB is mapped on its own and unmapped when freed, and a thread's heap
+/// gives back what is free above 128 KiB. Left to itself, glibc raises both to the
+/// largest block freed (the viewer frees frames of up to 44 MB), and `malloc_trim`
+/// cannot shrink the top of a thread's heap: the idle window at 640x360 then held
+/// 7 to 37 MiB depending on the sizes before (docs/log.md, 2026-12-02).
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn return_large_blocks() {
+    const THRESHOLD: libc::c_int = 128 * 1024;
+    // SAFETY: mallopt takes no pointers; it sets two of glibc's numbers.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, THRESHOLD);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, THRESHOLD);
+    }
+}
+
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn return_large_blocks() {}
 
 pub(crate) fn scene_command(seed: u64) -> anyhow::Result<()> {
     use std::io::Write;

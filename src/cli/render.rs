@@ -125,7 +125,7 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     opts.check()?;
 
     let control = Arc::new(RenderControl::default());
-    super::stop_on_signals(Some(Arc::clone(&control)))?;
+    super::stop_on_signals(super::cancel(&control))?;
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let area = opts.area();
     let progress = show_progress.then(|| {

@@ -33,7 +33,7 @@ fn parse_image_path(text: &str) -> Result<PathBuf, String> {
 pub(crate) fn stitch_command(args: StitchArgs) -> anyhow::Result<()> {
     let format = Format::from_path(&args.output, args.ppm_binary)?;
     image_io::check_writable(&args.output)?;
-    super::stop_on_signals(None)?;
+    super::stop_on_signals(|| {})?;
     let mut read: Vec<(String, parts::Part)> = Vec::new();
     for path in &args.parts {
         if image_io::writes_interrupted() {

@@ -6,7 +6,7 @@
 mod animated;
 mod atomic;
 
-use std::io::{BufRead, Cursor, Seek, Write};
+use std::io::{BufRead, Cursor, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use image::codecs::bmp::BmpEncoder;
@@ -196,16 +196,75 @@ pub struct SaveError {
 /// from its first bytes, else `format`, within `limits` on size and memory
 /// (`image::Limits::default()` for files, smaller ones to fuzz faster).
 pub fn decode_image<R: BufRead + Seek>(
-    reader: R,
+    mut reader: R,
     format: Option<image::ImageFormat>,
     limits: image::Limits,
 ) -> image::ImageResult<DynamicImage> {
+    check_header_fits(&mut reader, format)?;
     let mut reader = image::ImageReader::new(reader);
     if let Some(format) = format {
         reader.set_format(format);
     }
     reader.limits(limits);
     reader.with_guessed_format()?.decode()
+}
+
+/// Refuses a PNG file whose header states more pixels than its bytes can hold (see
+/// [`check_holds`]), before the decoder allocates them (up to the 512 MiB of
+/// `image::Limits::default()`); leaves `reader` where it was. (`image`'s EXR decoder
+/// reads the table of every chunk its header calls for before it allocates pixels.)
+fn check_header_fits<R: BufRead + Seek>(
+    reader: &mut R,
+    format: Option<image::ImageFormat>,
+) -> image::ImageResult<()> {
+    use image::error::{DecodingError, ImageFormatHint};
+    use image::ImageFormat;
+    let start = reader.stream_position()?;
+    let file_bytes = bytes_left(reader)?;
+    let mut probe = image::ImageReader::new(&mut *reader);
+    if let Some(format) = format {
+        probe.set_format(format);
+    }
+    let probe = probe.with_guessed_format()?;
+    if probe.format() == Some(ImageFormat::Png) {
+        // A header the probe cannot read is the decoder's to report.
+        if let Ok((width, height)) = probe.into_dimensions() {
+            // The fewest bits a pixel takes before compression: 1-bit grey or palette.
+            check_holds(width, height, 1, file_bytes).map_err(|message| {
+                let hint = ImageFormatHint::Exact(ImageFormat::Png);
+                image::ImageError::Decoding(DecodingError::new(hint, message))
+            })?;
+        }
+    }
+    reader.seek(SeekFrom::Start(start))?;
+    Ok(())
+}
+
+/// Fails unless a file of `file_bytes` bytes can hold `width`×`height` pixels of at
+/// least `bits_per_pixel` bits each before compression (at most
+/// [`limits::MAX_EXPANSION`](crate::limits::MAX_EXPANSION) bytes a byte): a header
+/// of a few bytes stating a huge image is refused before the image is allocated.
+pub(crate) fn check_holds(
+    width: u32,
+    height: u32,
+    bits_per_pixel: u64,
+    file_bytes: u64,
+) -> Result<(), String> {
+    let bytes = u64::from(width) * u64::from(height) * bits_per_pixel / 8;
+    if bytes > file_bytes.saturating_mul(crate::limits::MAX_EXPANSION) {
+        return Err(format!(
+            "its header states {width}x{height} pixels, more than its {file_bytes} bytes can hold"
+        ));
+    }
+    Ok(())
+}
+
+/// The bytes from `reader`'s position to its end; leaves it where it was.
+pub(crate) fn bytes_left<R: Seek>(reader: &mut R) -> std::io::Result<u64> {
+    let here = reader.stream_position()?;
+    let end = reader.seek(SeekFrom::End(0))?;
+    reader.seek(SeekFrom::Start(here))?;
+    Ok(end.saturating_sub(here))
 }
 
 /// Encodes 8-bit RGB (top row first) in `format`.

@@ -14,7 +14,9 @@ use std::str::FromStr;
 use glam::Vec3;
 use image::{Rgb32FImage, RgbImage};
 
-use super::{exr_bytes, to_rgb32f, to_rgb8, write_atomically, Format, SaveError};
+use super::{
+    bytes_left, check_holds, exr_bytes, to_rgb32f, to_rgb8, write_atomically, Format, SaveError,
+};
 use crate::limits;
 use crate::render::Frame;
 use crate::scene::{to_toml, Scene};
@@ -308,7 +310,12 @@ fn no_record() -> String {
     "records no place in an image: not written with --tile or --region".into()
 }
 
-fn decode_png_part<R: BufRead + Seek>(reader: R) -> Result<Part, String> {
+/// The fewest bits a part's pixel takes before compression: 8-bit RGB in a PNG (an
+/// EXR part's three channels take at least 48).
+const LEAST_PART_BITS: u64 = 24;
+
+fn decode_png_part<R: BufRead + Seek>(mut reader: R) -> Result<Part, String> {
+    let file_bytes = bytes_left(&mut reader).map_err(|e| e.to_string())?;
     let decoder = png::Decoder::new(reader);
     let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
     let placement = reader
@@ -323,6 +330,7 @@ fn decode_png_part<R: BufRead + Seek>(reader: R) -> Result<Part, String> {
         return Err("not an 8-bit RGB PNG".into());
     }
     check_size(&placement, info.width, info.height)?;
+    check_holds(info.width, info.height, LEAST_PART_BITS, file_bytes)?;
     let mut buf = vec![0; reader.output_buffer_size().ok_or("an image too large")?];
     let frame = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
     buf.truncate(frame.buffer_size());
@@ -340,6 +348,7 @@ fn decode_exr_part<R: BufRead + Seek>(mut reader: R) -> Result<Part, String> {
     use exr::prelude::traits::{ReadChannels, ReadLayers};
     // The headers first: their sizes decide what the pixels take, and a part's are
     // known from its record before anything that large is allocated.
+    let file_bytes = bytes_left(&mut reader).map_err(|e| e.to_string())?;
     let meta = MetaData::read_from_buffered(&mut reader, false).map_err(|e| e.to_string())?;
     let header = meta.headers.first().ok_or("an EXR file with no layer")?;
     let placement = match header
@@ -356,7 +365,9 @@ fn decode_exr_part<R: BufRead + Seek>(mut reader: R) -> Result<Part, String> {
     }
     let side = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
     let size = header.layer_size;
-    check_size(&placement, side(size.width()), side(size.height()))?;
+    let (width, height) = (side(size.width()), side(size.height()));
+    check_size(&placement, width, height)?;
+    check_holds(width, height, LEAST_PART_BITS, file_bytes)?;
     reader.rewind().map_err(|e| e.to_string())?;
     let image = exr::prelude::read()
         .no_deep_data()

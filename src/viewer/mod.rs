@@ -41,8 +41,44 @@ use worker::{Report, Shown, Worker};
 /// A press and release closer than this (pixels) is a click, not a drag.
 const CLICK_SLOP: f64 = 3.0;
 
+/// What wakes the event loop besides the window's own events.
+enum Wake {
+    /// A finished pass, or a failed render, from the worker.
+    Report(Report),
+    /// [`Stop::stop`]: close the window.
+    Stop,
+}
+
+/// Closes the window from any thread (a signal handler's): the viewer stops, waits
+/// for the saves in flight, and [`run`] returns [`Interrupted`].
+#[derive(Clone)]
+pub struct Stop(EventLoopProxy<Wake>);
+
+impl Stop {
+    pub fn stop(&self) {
+        // After the loop has closed there is nothing left to stop.
+        let _ = self.0.send_event(Wake::Stop);
+    }
+}
+
+/// The viewer was closed by [`Stop::stop`].
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted")]
+pub struct Interrupted;
+
+/// What the program that opens the window lends it.
+pub struct Host {
+    /// Called before the window opens, with a handle that closes it (the command line
+    /// hands it to its signal handler).
+    pub on_open: Box<dyn FnOnce(Stop) -> anyhow::Result<()>>,
+    /// Called when a view is complete: gives the memory the views freed back to the
+    /// system (the command line calls glibc's `malloc_trim`, which frees the unused
+    /// pages inside the arenas of rayon's threads).
+    pub release_memory: fn(),
+}
+
 /// Opens the viewer on `scene` and returns when the window closes.
-pub fn run(scene: Scene) -> anyhow::Result<()> {
+pub fn run(scene: Scene, host: Host) -> anyhow::Result<()> {
     let started = Instant::now();
     let choice = blit::parse_choice(std::env::var("WHITTED_BLIT").ok().as_deref())
         .map_err(|e| anyhow!(e))?;
@@ -55,11 +91,13 @@ pub fn run(scene: Scene) -> anyhow::Result<()> {
         bail!("no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset); {hint}");
     }
     let _runtime_dir = quiet_wayland_probe();
-    let event_loop = EventLoop::<Report>::with_user_event()
+    let event_loop = EventLoop::<Wake>::with_user_event()
         .build()
         .map_err(|e| anyhow!("cannot open the display ({}); {hint}", winit_message(&e)))?;
     event_loop.set_control_flow(ControlFlow::Wait);
-    let mut app = App::new(scene, event_loop.create_proxy(), choice, stats, started);
+    (host.on_open)(Stop(event_loop.create_proxy()))?;
+    let proxy = event_loop.create_proxy();
+    let mut app = App::new(scene, proxy, choice, stats, started, host.release_memory);
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
@@ -145,20 +183,23 @@ struct App {
     job_started: Instant,
     /// Playing, the current frame is complete and the next is due at this time.
     next_frame_at: Option<Instant>,
+    /// See [`Host::release_memory`].
+    release_memory: fn(),
 }
 
 impl App {
     fn new(
         scene: Scene,
-        proxy: EventLoopProxy<Report>,
+        proxy: EventLoopProxy<Wake>,
         choice: Choice,
         stats: bool,
         started: Instant,
+        release_memory: fn(),
     ) -> App {
         let scene = Arc::new(scene);
         // The proxy wakes the event loop; after it has closed, reports are dropped.
         let worker = Worker::spawn(move |report| {
-            let _ = proxy.send_event(report);
+            let _ = proxy.send_event(Wake::Report(report));
         });
         App {
             stem: save::file_stem(&scene.name),
@@ -192,6 +233,7 @@ impl App {
             playing: false,
             job_started: started,
             next_frame_at: None,
+            release_memory,
         }
     }
 
@@ -405,7 +447,11 @@ impl App {
             }
         };
         let complete = shown.done;
+        // The frames of the passes before this one are freed here.
         self.shown = Some((shown, Arc::clone(&self.job_scene)));
+        if complete {
+            (self.release_memory)();
+        }
         self.shown_frame = self.job_frame;
         self.fresh = true;
         if complete && self.playing {
@@ -473,7 +519,7 @@ impl App {
     }
 }
 
-impl ApplicationHandler<Report> for App {
+impl ApplicationHandler<Wake> for App {
     /// Playing: waits (without blocking the loop) until the next frame is due.
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         match self.next_frame_at {
@@ -525,13 +571,14 @@ impl ApplicationHandler<Report> for App {
         }
     }
 
-    fn user_event(&mut self, _event_loop: &ActiveEventLoop, report: Report) {
-        match report {
-            Report::Frame(shown) => self.frame_ready(shown),
-            Report::Failed {
+    fn user_event(&mut self, event_loop: &ActiveEventLoop, wake: Wake) {
+        match wake {
+            Wake::Stop => self.fail(event_loop, Interrupted.into()),
+            Wake::Report(Report::Frame(shown)) => self.frame_ready(shown),
+            Wake::Report(Report::Failed {
                 generation,
                 message,
-            } => {
+            }) => {
                 if generation == self.generation {
                     eprintln!("whitted: cannot render this view: {message}");
                     self.progress = Progress::Failed;

@@ -233,9 +233,19 @@ impl<T> Recycler<T> {
         Arc::try_unwrap(self.sent.remove(free)?).ok()
     }
 
-    /// Forgets the values nobody else holds (their memory is freed).
-    fn drop_free(&mut self) {
-        self.sent.retain(|a| Arc::strong_count(a) > 1);
+    /// Forgets every value sent: those nobody else holds are freed now, the others
+    /// when their holders let go.
+    fn forget(&mut self) {
+        self.sent.clear();
+    }
+
+    /// Calls `fit` on each value nobody else holds.
+    fn fit_free(&mut self, mut fit: impl FnMut(&mut T)) {
+        for value in &mut self.sent {
+            if let Some(value) = Arc::get_mut(value) {
+                fit(value);
+            }
+        }
     }
 
     /// `value`, taken and not sent, back for a later [`Recycler::take`].
@@ -252,6 +262,27 @@ impl<T> Recycler<T> {
         }
         shared
     }
+}
+
+impl Buffers {
+    /// At the end of a view: no buffer larger than the view needs, so that what the
+    /// idle viewer holds depends on the window's size, not on the sizes before it.
+    /// (The sums may be the pixels of a frame of an earlier, larger view, handed over
+    /// by the last pass: 44 MB after a 2560×1440 view.) Shrinking moves nothing.
+    fn fit(&mut self) {
+        let n = self.size.0 as usize * self.size.1 as usize;
+        fit(&mut self.sums, n);
+        // The preview's values are read by the view's first full pass only.
+        self.preview_sums = Vec::new();
+        self.frames.fit_free(|frame| fit(&mut frame.pixels, n));
+        self.rgba.fit_free(|rgba| fit(rgba, 4 * n));
+    }
+}
+
+/// `buffer` cut to at most `len` values, its spare capacity freed.
+fn fit<T>(buffer: &mut Vec<T>, len: usize) {
+    buffer.truncate(len);
+    buffer.shrink_to_fit();
 }
 
 /// Renders all passes of `job`, reporting each; stops early when cancelled.
@@ -295,11 +326,12 @@ fn passes<T: SampleTracer + ?Sized>(
     let passes = plan(w, h, target, job.preview_factor);
     let last = passes.len() - 1;
     if buffers.size != (w, h) {
-        // A new size: the pooled buffers of the old one are let go (those the window
-        // still holds are resized when they come back).
+        // A new size: the pooled buffers of the old one are let go, also those the
+        // window still holds (taken back, a 2560×1440 frame kept its 44 MB in the
+        // pool while the window showed a 640×360 view).
         buffers.size = (w, h);
-        buffers.frames.drop_free();
-        buffers.rgba.drop_free();
+        buffers.frames.forget();
+        buffers.rgba.forget();
     }
     resize_buffer(&mut buffers.sums, w as usize * h as usize, Vec3::ZERO);
     // The lattice a preview has traced, until the first full pass takes it.
@@ -364,6 +396,9 @@ fn passes<T: SampleTracer + ?Sized>(
                 rgba
             }
         };
+        if index == last {
+            buffers.fit();
+        }
         sink(Report::Frame(Shown {
             generation: job.generation,
             frame: buffers.frames.send(frame),
@@ -509,6 +544,43 @@ mod tests {
             *shown[0].rgba,
             to_rgba_top_down(&shown[0].frame, Encoding::Linear)
         );
+    }
+
+    /// After a large view, a small one leaves no buffer larger than it needs, whether
+    /// the window still held the large frame when the small view began (it keeps it
+    /// until the small view's first pass shows) or had let go of it.
+    #[test]
+    fn buffers_shrink_to_the_view_after_a_larger_one() {
+        let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+        scene.image.spp = Some(1);
+        let scene = Arc::new(scene);
+        for window_holds_the_large_frame in [true, false] {
+            let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
+            let shown = Arc::new(Mutex::new(Vec::new()));
+            let sink = {
+                let shown = Arc::clone(&shown);
+                move |r: Report| match r {
+                    Report::Frame(s) => shown.lock().unwrap().push(s),
+                    Report::Failed { message, .. } => panic!("render failed: {message}"),
+                }
+            };
+            let large = Job::new(1, Arc::clone(&scene), (400, 300), 4);
+            run(&large, &mut cache, &mut buffers, &sink).unwrap();
+            let held = window_holds_the_large_frame.then(|| shown.lock().unwrap().pop());
+            shown.lock().unwrap().clear();
+            let small = Job::new(2, Arc::clone(&scene), (40, 30), 4);
+            run(&small, &mut cache, &mut buffers, &sink).unwrap();
+            drop(held);
+            let n = 40 * 30;
+            assert!(buffers.sums.capacity() <= n, "{}", buffers.sums.capacity());
+            assert!(buffers.preview_sums.capacity() <= n);
+            for frame in &buffers.frames.sent {
+                assert!(frame.pixels.capacity() <= n, "{}", frame.pixels.capacity());
+            }
+            for rgba in &buffers.rgba.sent {
+                assert!(rgba.capacity() <= 4 * n, "{}", rgba.capacity());
+            }
+        }
     }
 
     /// What a preview at 1/`factor` of the size shows, from the first full pass: over
