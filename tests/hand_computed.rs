@@ -5,6 +5,7 @@
 
 use glam::{DVec3, Vec3};
 use whitted::camera::{self, Camera, CameraError, CameraSpec};
+use whitted::intersect;
 use whitted::model;
 use whitted::render::{self, Frame, RenderControl};
 use whitted::settings::Precision;
@@ -191,6 +192,122 @@ fn combine_mixes_local_reflected_and_transmitted() {
     // w_r + w_t > 1 is allowed and stays a convex mix (SPEC §3).
     let c = model::combine(0.9, 0.9, DVec3::ONE, DVec3::ONE, DVec3::ONE);
     assert!(close(c, DVec3::ONE, 1e-15));
+}
+
+// ---------------------------------------------------------------------------------
+// Ray and sphere (SPEC §3: the stable roots of Ray Tracing Gems ch. 7)
+// ---------------------------------------------------------------------------------
+
+/// The roots and both normals of `o + t·d` with the sphere `(c, r)` in `f64` and in
+/// `f32`, against the hand values `(near, far, normal_near, normal_far)`.
+#[track_caller]
+fn assert_roots(o: [f64; 3], d: [f64; 3], c: [f64; 3], r: f64, want: (f64, f64, DVec3, DVec3)) {
+    let (o, d, c) = (DVec3::from(o), DVec3::from(d), DVec3::from(c));
+    let hit = intersect::roots(o, d, c, r).expect("a hit");
+    assert!(
+        (hit.near - want.0).abs() < 1e-12,
+        "near {} vs {}",
+        hit.near,
+        want.0
+    );
+    assert!(
+        (hit.far - want.1).abs() < 1e-12,
+        "far {} vs {}",
+        hit.far,
+        want.1
+    );
+    assert!(
+        close(hit.normal_near(d, r), want.2, 1e-12),
+        "{}",
+        hit.normal_near(d, r)
+    );
+    assert!(
+        close(hit.normal_far(d, r), want.3, 1e-12),
+        "{}",
+        hit.normal_far(d, r)
+    );
+    let hit = intersect::roots(o.as_vec3(), d.as_vec3(), c.as_vec3(), r as f32).expect("a hit");
+    assert!(
+        (f64::from(hit.near) - want.0).abs() < 1e-5,
+        "f32 near {}",
+        hit.near
+    );
+    assert!(
+        (f64::from(hit.far) - want.1).abs() < 1e-5,
+        "f32 far {}",
+        hit.far
+    );
+    let (n, f) = (
+        hit.normal_near(d.as_vec3(), r as f32),
+        hit.normal_far(d.as_vec3(), r as f32),
+    );
+    assert!(close(n.as_dvec3(), want.2, 1e-6), "f32 {n}");
+    assert!(close(f.as_dvec3(), want.3, 1e-6), "f32 {f}");
+}
+
+#[test]
+fn ray_sphere_roots_and_normals_by_hand() {
+    // From (1, 0, 0) down −z to the ball of radius 3 at (0, 0, −5): the line passes 1
+    // from the centre, half the chord is √(9 − 1) = 2√2, so t = 5 ∓ 2√2; the hits are
+    // (1, 0, −5 ± 2√2), normals (1, 0, ±2√2)/3.
+    let s = 2.0 * 2f64.sqrt();
+    let (n_front, n_back) = (
+        DVec3::new(1.0, 0.0, s) / 3.0,
+        DVec3::new(1.0, 0.0, -s) / 3.0,
+    );
+    let ball = ([0.0, 0.0, -5.0], 3.0);
+    assert_roots(
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, -1.0],
+        ball.0,
+        ball.1,
+        (5.0 - s, 5.0 + s, n_front, n_back),
+    );
+    // From inside, at the depth of the centre: t = ∓2√2, the same points.
+    assert_roots(
+        [1.0, 0.0, -5.0],
+        [0.0, 0.0, -1.0],
+        ball.0,
+        ball.1,
+        (-s, s, n_front, n_back),
+    );
+    // Looking away (+z): both roots behind, t = −5 ∓ 2√2, near is the far side.
+    assert_roots(
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        ball.0,
+        ball.1,
+        (-5.0 - s, -5.0 + s, n_back, n_front),
+    );
+    // A tangent line (1 from the centre of a unit ball): the double root t = 5, whose
+    // normal is (1, 0, 0) either way.
+    let x = DVec3::X;
+    assert_roots(
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, -1.0],
+        [0.0, 0.0, -5.0],
+        1.0,
+        (5.0, 5.0, x, x),
+    );
+    // Starting on the surface at (0.6, 0.8, 0) of the unit ball at the origin, aimed
+    // through its centre: t = 0 and t = 2, normals ±(0.6, 0.8, 0). The near root comes
+    // from c/q with q = 2 (no cancellation of b' − √disc).
+    let p = DVec3::new(0.6, 0.8, 0.0);
+    assert_roots(
+        [0.6, 0.8, 0.0],
+        [-0.6, -0.8, 0.0],
+        [0.0; 3],
+        1.0,
+        (0.0, 2.0, p, -p),
+    );
+    // Passing 1.5 from the centre of a unit ball: a miss.
+    let miss = intersect::roots(
+        DVec3::new(1.5, 0.0, 0.0),
+        DVec3::NEG_Z,
+        DVec3::new(0.0, 0.0, -5.0),
+        1.0,
+    );
+    assert!(miss.is_none());
 }
 
 // ---------------------------------------------------------------------------------
