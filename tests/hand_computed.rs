@@ -300,6 +300,10 @@ fn ray_sphere_roots_and_normals_by_hand() {
         1.0,
         (0.0, 2.0, p, -p),
     );
+    // From the same point straight out: t = −2 and 0 (the centre behind, b' < 0: the
+    // near root is q = b' − √disc = −2, the far one c/q, again no cancellation).
+    let out = [0.6, 0.8, 0.0];
+    assert_roots(out, out, [0.0; 3], 1.0, (-2.0, 0.0, -p, p));
     // Passing 1.5 from the centre of a unit ball: a miss.
     let miss = intersect::roots(
         DVec3::new(1.5, 0.0, 0.0),
