@@ -39,7 +39,9 @@ fi
 exclude='image_io/mod.rs:.*(replace|in) (save|save_rgb8|encode|encode_rgb8|exr_bytes|write_atomically|temp_file_for|target_of|folder_of|check_writable|Format::from_path|to_rgb32f)\b'
 exclude+='|TreeRecorder|RayKind::name'
 
-# The tests each mutant runs (cargo's target options); override with MUTANTS_TESTS.
+# The tests each mutant runs (cargo's target options); override with MUTANTS_TESTS,
+# best with the targets that exercise the module run (docs/testing.md has a table),
+# e.g. MUTANTS_TESTS=--lib for src/sampling.rs: fewer targets, a cheaper build.
 tests=${MUTANTS_TESTS:---lib --test=hand_computed --test=accuracy --test=refraction --test=stress_scenes --test=quality}
 targets=()
 for t in $tests; do

@@ -52,6 +52,98 @@ mod tests {
         ((sx * nx as f32) as u32, (sy * ny as f32) as u32)
     }
 
+    /// The first outputs of splitmix64 seeded with 0 (its state steps by the golden
+    /// gamma `0x9e3779b97f4a7c15`), as printed by Vigna's reference `splitmix64.c`.
+    #[test]
+    fn mix_is_splitmix64_s_finaliser() {
+        let gamma = 0x9e37_79b9_7f4a_7c15u64;
+        let published = [
+            0xe220_a839_7b1d_cdaf,
+            0x6e78_9e6a_a1b9_65f4,
+            0x06c4_5d18_8009_454f,
+            0xf88b_b8a8_724c_81ec,
+        ];
+        for (n, want) in (1u64..).zip(published) {
+            assert_eq!(mix(gamma.wrapping_mul(n)), want, "output {n}");
+        }
+    }
+
+    /// A counter-based hash of (pixel, sample, seed): flipping any one bit of any input
+    /// changes the hash, about half of its 64 bits on average (avalanche).
+    #[test]
+    fn hash_depends_on_every_bit_of_every_input() {
+        let (i, j, k, seed) = (1234u32, 567u32, 9u32, 0x5eed_u64);
+        let base = hash(i, j, k, seed);
+        let mut flipped = Vec::new();
+        for b in 0..32 {
+            flipped.push(hash(i ^ 1 << b, j, k, seed));
+            flipped.push(hash(i, j ^ 1 << b, k, seed));
+            flipped.push(hash(i, j, k ^ 1 << b, seed));
+        }
+        for b in 0..64 {
+            flipped.push(hash(i, j, k, seed ^ 1 << b));
+        }
+        let changed: Vec<u32> = flipped.iter().map(|h| (h ^ base).count_ones()).collect();
+        assert!(changed.iter().all(|&c| c > 0), "{changed:?}");
+        let mean = changed.iter().sum::<u32>() as f64 / changed.len() as f64;
+        // 160 flips of Binomial(64, ½) bits: mean 32, standard error 0.32.
+        assert!((mean - 32.0).abs() < 2.0, "mean {mean} bits changed");
+    }
+
+    /// Where each sample sits inside its cell is uniform on [0, 1)² (10 bins a side
+    /// hold a tenth each), and no two samples of the 64×64 pixels share a position.
+    #[test]
+    fn jitter_is_uniform_inside_the_cells_and_never_repeats() {
+        let spp = 16;
+        let mut bins = [[0u32; 10]; 2];
+        let mut positions = std::collections::HashSet::new();
+        let mut sums = [0.0f64; 2];
+        for j in 0..64 {
+            for i in 0..64 {
+                for k in 0..spp {
+                    let (sx, sy) = sample_offset(i, j, k, spp, 3);
+                    let new = positions.insert((sx.to_bits(), sy.to_bits()));
+                    assert!(new, "pixel ({i}, {j}) sample {k} repeats a position");
+                    for (axis, s) in [sx, sy].into_iter().enumerate() {
+                        let within = (f64::from(s) * 4.0).fract();
+                        sums[axis] += within;
+                        bins[axis][(within * 10.0) as usize] += 1;
+                    }
+                }
+            }
+        }
+        let n = 64.0 * 64.0 * f64::from(spp);
+        for axis in 0..2 {
+            // Mean ½ within 0.005 (the standard error is 0.0011).
+            assert!(
+                (sums[axis] / n - 0.5).abs() < 0.005,
+                "axis {axis}: {}",
+                sums[axis] / n
+            );
+            for b in bins[axis] {
+                // 6,554 expected a bin, standard deviation 77.
+                assert!(
+                    (f64::from(b) / n - 0.1).abs() < 0.005,
+                    "axis {axis}: {:?}",
+                    bins[axis]
+                );
+            }
+        }
+    }
+
+    /// Offsets stay below 1 (SPEC §2: in [0,1)²) even where `(cy + jitter)/ny` rounds
+    /// up to 1 in `f32`: sample 3 of 4 of pixel (2544, 731), seed 7 (found by a search
+    /// over the hash) falls in the top row of cells with all 24 jitter bits set.
+    #[test]
+    fn the_topmost_jitter_stays_inside_the_pixel() {
+        let (i, j, k, spp, seed) = (2544, 731, 3, 4, 7);
+        assert_eq!(hash(i, j, k, seed) >> 32 & 0xff_ffff, 0xff_ffff);
+        let (_, sy) = sample_offset(i, j, k, spp, seed);
+        assert!(sy < 1.0, "{sy}");
+        // At most a rounding step or two of f32 below 1 (6e-8 each).
+        assert!(sy > 1.0 - 1e-7, "{sy}");
+    }
+
     #[test]
     fn one_sample_is_the_pixel_centre() {
         assert_eq!(sample_offset(3, 4, 0, 1, 9), (0.5, 0.5));

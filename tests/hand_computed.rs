@@ -4,6 +4,8 @@
 //! `Scene::from_toml_str` + `render::render`, with the fast tracer and the reference.
 
 use glam::{DVec3, Vec3};
+use whitted::camera::{self, Camera, CameraError, CameraSpec};
+use whitted::intersect;
 use whitted::model;
 use whitted::render::{self, Frame, RenderControl};
 use whitted::settings::Precision;
@@ -190,6 +192,301 @@ fn combine_mixes_local_reflected_and_transmitted() {
     // w_r + w_t > 1 is allowed and stays a convex mix (SPEC §3).
     let c = model::combine(0.9, 0.9, DVec3::ONE, DVec3::ONE, DVec3::ONE);
     assert!(close(c, DVec3::ONE, 1e-15));
+}
+
+// ---------------------------------------------------------------------------------
+// Ray and sphere (SPEC §3: the stable roots of Ray Tracing Gems ch. 7)
+// ---------------------------------------------------------------------------------
+
+/// The roots and both normals of `o + t·d` with the sphere `(c, r)` in `f64` and in
+/// `f32`, against the hand values `(near, far, normal_near, normal_far)`.
+#[track_caller]
+fn assert_roots(o: [f64; 3], d: [f64; 3], c: [f64; 3], r: f64, want: (f64, f64, DVec3, DVec3)) {
+    let (o, d, c) = (DVec3::from(o), DVec3::from(d), DVec3::from(c));
+    let hit = intersect::roots(o, d, c, r).expect("a hit");
+    assert!(
+        (hit.near - want.0).abs() < 1e-12,
+        "near {} vs {}",
+        hit.near,
+        want.0
+    );
+    assert!(
+        (hit.far - want.1).abs() < 1e-12,
+        "far {} vs {}",
+        hit.far,
+        want.1
+    );
+    assert!(
+        close(hit.normal_near(d, r), want.2, 1e-12),
+        "{}",
+        hit.normal_near(d, r)
+    );
+    assert!(
+        close(hit.normal_far(d, r), want.3, 1e-12),
+        "{}",
+        hit.normal_far(d, r)
+    );
+    let hit = intersect::roots(o.as_vec3(), d.as_vec3(), c.as_vec3(), r as f32).expect("a hit");
+    assert!(
+        (f64::from(hit.near) - want.0).abs() < 1e-5,
+        "f32 near {}",
+        hit.near
+    );
+    assert!(
+        (f64::from(hit.far) - want.1).abs() < 1e-5,
+        "f32 far {}",
+        hit.far
+    );
+    let (n, f) = (
+        hit.normal_near(d.as_vec3(), r as f32),
+        hit.normal_far(d.as_vec3(), r as f32),
+    );
+    assert!(close(n.as_dvec3(), want.2, 1e-6), "f32 {n}");
+    assert!(close(f.as_dvec3(), want.3, 1e-6), "f32 {f}");
+}
+
+#[test]
+fn ray_sphere_roots_and_normals_by_hand() {
+    // From (1, 0, 0) down −z to the ball of radius 3 at (0, 0, −5): the line passes 1
+    // from the centre, half the chord is √(9 − 1) = 2√2, so t = 5 ∓ 2√2; the hits are
+    // (1, 0, −5 ± 2√2), normals (1, 0, ±2√2)/3.
+    let s = 2.0 * 2f64.sqrt();
+    let (n_front, n_back) = (
+        DVec3::new(1.0, 0.0, s) / 3.0,
+        DVec3::new(1.0, 0.0, -s) / 3.0,
+    );
+    let ball = ([0.0, 0.0, -5.0], 3.0);
+    assert_roots(
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, -1.0],
+        ball.0,
+        ball.1,
+        (5.0 - s, 5.0 + s, n_front, n_back),
+    );
+    // From inside, at the depth of the centre: t = ∓2√2, the same points.
+    assert_roots(
+        [1.0, 0.0, -5.0],
+        [0.0, 0.0, -1.0],
+        ball.0,
+        ball.1,
+        (-s, s, n_front, n_back),
+    );
+    // Looking away (+z): both roots behind, t = −5 ∓ 2√2, near is the far side.
+    assert_roots(
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        ball.0,
+        ball.1,
+        (-5.0 - s, -5.0 + s, n_back, n_front),
+    );
+    // A tangent line (1 from the centre of a unit ball): the double root t = 5, whose
+    // normal is (1, 0, 0) either way.
+    let x = DVec3::X;
+    assert_roots(
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, -1.0],
+        [0.0, 0.0, -5.0],
+        1.0,
+        (5.0, 5.0, x, x),
+    );
+    // Starting on the surface at (0.6, 0.8, 0) of the unit ball at the origin, aimed
+    // through its centre: t = 0 and t = 2, normals ±(0.6, 0.8, 0). The near root comes
+    // from c/q with q = 2 (no cancellation of b' − √disc).
+    let p = DVec3::new(0.6, 0.8, 0.0);
+    assert_roots(
+        [0.6, 0.8, 0.0],
+        [-0.6, -0.8, 0.0],
+        [0.0; 3],
+        1.0,
+        (0.0, 2.0, p, -p),
+    );
+    // From the same point straight out: t = −2 and 0 (the centre behind, b' < 0: the
+    // near root is q = b' − √disc = −2, the far one c/q, again no cancellation).
+    let out = [0.6, 0.8, 0.0];
+    assert_roots(out, out, [0.0; 3], 1.0, (-2.0, 0.0, -p, p));
+    // Passing 1.5 from the centre of a unit ball: a miss.
+    let miss = intersect::roots(
+        DVec3::new(1.5, 0.0, 0.0),
+        DVec3::NEG_Z,
+        DVec3::new(0.0, 0.0, -5.0),
+        1.0,
+    );
+    assert!(miss.is_none());
+}
+
+// ---------------------------------------------------------------------------------
+// The camera (SPEC §2 "Camera and pixels", §3 degenerate cameras)
+// ---------------------------------------------------------------------------------
+
+fn look_at(from: [f64; 3], at: [f64; 3], up: [f64; 3], vfov: f64) -> CameraSpec {
+    CameraSpec::LookAt {
+        look_from: DVec3::from(from),
+        look_at: DVec3::from(at),
+        up: DVec3::from(up),
+        vfov,
+    }
+}
+
+fn frame_spec(origin: [f64; 3], ll: [f64; 3], h: [f64; 3], v: [f64; 3]) -> CameraSpec {
+    CameraSpec::Frame {
+        origin: DVec3::from(origin),
+        lower_left: DVec3::from(ll),
+        horizontal: DVec3::from(h),
+        vertical: DVec3::from(v),
+    }
+}
+
+#[track_caller]
+fn assert_camera(c: Camera, o: [f64; 3], ll: [f64; 3], h: [f64; 3], v: [f64; 3]) {
+    let want = [o, ll, h, v].map(DVec3::from);
+    let got = [c.origin, c.lower_left, c.horizontal, c.vertical];
+    for (name, (g, w)) in ["O", "LL", "H", "V"].iter().zip(got.iter().zip(want)) {
+        assert!(close(*g, w, 1e-12), "{name}: {g} vs {w}");
+    }
+}
+
+#[test]
+fn look_at_camera_by_the_spec_s_formulas() {
+    // From (1, 2, 3) towards (5, 2, 3), up (0, 2, 0) (not unit), vfov = 2·atan(1/2), a
+    // 4×2 image: w = (−1, 0, 0), u = up × w normalised = (0, 0, 1), v = w × u =
+    // (0, 1, 0), h = 1/2, a = 2. O = (1, 2, 3), LL = O − a·h·u − h·v − w = (2, 1.5, 2),
+    // H = 2·a·h·u = (0, 0, 2), V = 2·h·v = (0, 1, 0).
+    let vfov = 2.0 * 0.5f64.atan().to_degrees();
+    let spec = look_at([1.0, 2.0, 3.0], [5.0, 2.0, 3.0], [0.0, 2.0, 0.0], vfov);
+    assert_eq!(spec.check(), Ok(()));
+    let c = Camera::new(&spec, 4, 2).unwrap();
+    assert_camera(
+        c,
+        [1.0, 2.0, 3.0],
+        [2.0, 1.5, 2.0],
+        [0.0, 0.0, 2.0],
+        [0.0, 1.0, 0.0],
+    );
+
+    // The assignment's look-at form at 16:9 is its exact frame (SPEC §2), and its vfov
+    // is 2·atan(2.25) = 132.0750°.
+    assert!((camera::assignment_vfov_degrees() - 132.075_022_05).abs() < 1e-8);
+    let assignment = [
+        [0.0, 0.0, 0.0],
+        [-4.0, -2.25, -1.0],
+        [8.0, 0.0, 0.0],
+        [0.0, 4.5, 0.0],
+    ];
+    for spec in [
+        CameraSpec::assignment_look_at(),
+        CameraSpec::assignment_frame(),
+    ] {
+        let c = Camera::new(&spec, 1280, 720).unwrap();
+        assert_camera(
+            c,
+            assignment[0],
+            assignment[1],
+            assignment[2],
+            assignment[3],
+        );
+    }
+}
+
+#[test]
+fn a_frame_camera_is_taken_as_given_and_turns_into_its_look_at_form() {
+    let (o, ll, h, v) = (
+        [1.0, 2.0, 3.0],
+        [-3.0, -0.25, 2.0],
+        [8.0, 0.0, 0.0],
+        [0.0, 4.5, 0.0],
+    );
+    let c = Camera::new(&frame_spec(o, ll, h, v), 7, 3).unwrap();
+    assert_camera(c, o, ll, h, v);
+    // The film centre LL + H/2 + V/2 = (1, 2, 2) is one unit ahead of O: look_at is
+    // that centre, up is V's direction, vfov = 2·atan((|V|/2)/1) = 2·atan(2.25).
+    let CameraSpec::LookAt {
+        look_from,
+        look_at,
+        up,
+        vfov,
+    } = c.to_look_at()
+    else {
+        panic!("to_look_at gives the look-at form")
+    };
+    assert_eq!(look_from, DVec3::new(1.0, 2.0, 3.0));
+    assert!(
+        close(look_at, DVec3::new(1.0, 2.0, 2.0), 1e-15),
+        "{look_at}"
+    );
+    assert!(close(up, DVec3::Y, 1e-15), "{up}");
+    assert!(
+        (vfov - 2.0 * 2.25f64.atan().to_degrees()).abs() < 1e-12,
+        "{vfov}"
+    );
+}
+
+#[test]
+fn degenerate_cameras_are_refused_with_their_reason() {
+    use CameraError::*;
+    let y = [0.0, 1.0, 0.0];
+    let cases = [
+        (
+            look_at([1.0, 2.0, 3.0], [1.0, 2.0, 3.0], y, 60.0),
+            SamePoints,
+        ),
+        // So far apart that |look_at − look_from|² overflows.
+        (
+            look_at([-1e200, 0.0, 0.0], [1e200, 0.0, 0.0], y, 60.0),
+            SamePoints,
+        ),
+        (look_at([0.0; 3], [0.0, 0.0, -1.0], [0.0; 3], 60.0), ZeroUp),
+        (
+            look_at([0.0; 3], [0.0, 0.0, -1.0], [0.0, 0.0, 3.0], 60.0),
+            UpParallel,
+        ),
+        // |up × w| = 1e-10 of |up|: parallel within rounding.
+        (
+            look_at([0.0; 3], [0.0, 0.0, -1.0], [1e-10, 0.0, 1.0], 60.0),
+            UpParallel,
+        ),
+        (look_at([0.0; 3], [0.0, 0.0, -1.0], y, 0.0), Vfov(0.0)),
+        (look_at([0.0; 3], [0.0, 0.0, -1.0], y, -5.0), Vfov(-5.0)),
+        (look_at([0.0; 3], [0.0, 0.0, -1.0], y, 180.0), Vfov(180.0)),
+        (look_at([0.0; 3], [0.0, 0.0, -1.0], y, 200.0), Vfov(200.0)),
+        (frame_spec([0.0; 3], [0.0; 3], [0.0; 3], y), ZeroSpan),
+        (frame_spec([0.0; 3], [0.0; 3], y, [0.0; 3]), ZeroSpan),
+        (
+            frame_spec([0.0; 3], [0.0; 3], [1.0, 0.0, 0.0], [-2.0, 0.0, 0.0]),
+            ParallelSpans,
+        ),
+        // |H × V| = 2e-9 ≤ 1e-12·|H|·|V| = 2e-8: the sine of their angle is 1e-13.
+        (
+            frame_spec([0.0; 3], [0.0; 3], [100.0, 0.0, 0.0], [200.0, 2e-11, 0.0]),
+            ParallelSpans,
+        ),
+        (
+            frame_spec([f64::INFINITY, 0.0, 0.0], [0.0; 3], [1.0, 0.0, 0.0], y),
+            NotFinite,
+        ),
+        (
+            frame_spec([0.0; 3], [f64::NAN; 3], [1.0, 0.0, 0.0], y),
+            NotFinite,
+        ),
+    ];
+    for (spec, want) in cases {
+        let got = Camera::new(&spec, 16, 9).unwrap_err();
+        assert_eq!(got, want, "{spec:?}");
+        // The spans are checked before the image size is known, finiteness after.
+        let checked = if want == NotFinite { Ok(()) } else { Err(want) };
+        assert_eq!(spec.check(), checked, "{spec:?}");
+    }
+    // Just inside each limit: accepted.
+    let z = [0.0, 0.0, -1.0];
+    for spec in [
+        look_at([0.0; 3], z, [1e-8, 0.0, 1.0], 60.0),
+        look_at([0.0; 3], z, y, 0.001),
+        look_at([0.0; 3], z, y, 179.9),
+        // |H × V| = 2e-7 > 2e-8: a sine of 1e-11.
+        frame_spec([0.0; 3], [0.0; 3], [100.0, 0.0, 0.0], [200.0, 2e-9, 0.0]),
+    ] {
+        assert_eq!(spec.check(), Ok(()), "{spec:?}");
+        assert!(Camera::new(&spec, 16, 9).is_ok(), "{spec:?}");
+    }
 }
 
 // ---------------------------------------------------------------------------------
