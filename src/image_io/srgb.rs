@@ -104,6 +104,43 @@ pub fn to_byte_srgb_exact(c: f32) -> u8 {
 mod tests {
     use super::*;
 
+    /// Each encoder gives the SPEC's bytes, worked by hand: linear
+    /// `round(clamp(c)·255)` with halves away from zero, and sRGB through
+    /// `12.92c` or `1.055·c^(1/2.4) − 0.055` (c = 0.5: 187.516 → 188; 0.2: 123.555 →
+    /// 124; 0.05: 63.189 → 63; 0.001: 3.295 → 3); out of range and NaN clamp.
+    #[test]
+    fn byte_encoders_give_the_spec_s_bytes_by_hand() {
+        use crate::image_io::ByteEncoder;
+        use crate::settings::Encoding;
+        let linear = ByteEncoder::new(Encoding::Linear);
+        for (c, byte) in [
+            (0.0, 0),
+            (1.0, 255),
+            (0.5, 128),
+            (0.2, 51),
+            (0.75, 191),
+            (-0.5, 0),
+            (7.0, 255),
+            (f32::NAN, 0),
+        ] {
+            assert_eq!(linear.byte(c), byte, "linear {c}");
+        }
+        let srgb = ByteEncoder::new(Encoding::Srgb);
+        for (c, byte) in [
+            (0.0, 0),
+            (1.0, 255),
+            (0.5, 188),
+            (0.2, 124),
+            (0.05, 63),
+            (0.001, 3),
+            (-0.5, 0),
+            (7.0, 255),
+            (f32::NAN, 0),
+        ] {
+            assert_eq!(srgb.byte(c), byte, "sRGB {c}");
+        }
+    }
+
     #[test]
     fn buckets_cover_two_to_the_minus_13_up_to_one() {
         assert_eq!(f32::from_bits(FIRST), 2f32.powi(-13));
