@@ -491,25 +491,34 @@ mod tests {
     use std::sync::Mutex;
     use std::time::Duration;
 
-    fn collect(worker_scene: Scene, w: u32, h: u32) -> Vec<Shown> {
-        let shown = Arc::new(Mutex::new(Vec::new()));
-        let sink = {
-            let shown = Arc::clone(&shown);
-            move |r: Report| match r {
-                Report::Frame(s) => shown.lock().unwrap().push(s),
+    /// The frames a worker reports, in order; a failed render fails the test.
+    #[derive(Default)]
+    struct Collected(Mutex<Vec<Shown>>);
+
+    impl Collected {
+        fn sink(&self) -> impl Fn(Report) + '_ {
+            |r: Report| match r {
+                Report::Frame(s) => self.0.lock().unwrap().push(s),
                 Report::Failed { message, .. } => panic!("render failed: {message}"),
             }
-        };
+        }
+
+        fn into_frames(self) -> Vec<Shown> {
+            self.0.into_inner().unwrap()
+        }
+    }
+
+    fn collect(worker_scene: Scene, w: u32, h: u32) -> Vec<Shown> {
+        let shown = Collected::default();
         let job = Job::new(7, Arc::new(worker_scene), (w, h), 4);
         run(
             &job,
             &mut TracerCache::default(),
             &mut Buffers::default(),
-            &sink,
+            &shown.sink(),
         )
         .unwrap();
-        let v = shown.lock().unwrap().clone();
-        v
+        shown.into_frames()
     }
 
     #[test]
@@ -556,18 +565,12 @@ mod tests {
         let scene = Arc::new(scene);
         for window_holds_the_large_frame in [true, false] {
             let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
-            let shown = Arc::new(Mutex::new(Vec::new()));
-            let sink = {
-                let shown = Arc::clone(&shown);
-                move |r: Report| match r {
-                    Report::Frame(s) => shown.lock().unwrap().push(s),
-                    Report::Failed { message, .. } => panic!("render failed: {message}"),
-                }
-            };
+            let shown = Collected::default();
+            let sink = shown.sink();
             let large = Job::new(1, Arc::clone(&scene), (400, 300), 4);
             run(&large, &mut cache, &mut buffers, &sink).unwrap();
-            let held = window_holds_the_large_frame.then(|| shown.lock().unwrap().pop());
-            shown.lock().unwrap().clear();
+            let held = window_holds_the_large_frame.then(|| shown.0.lock().unwrap().pop());
+            shown.0.lock().unwrap().clear();
             let small = Job::new(2, Arc::clone(&scene), (40, 30), 4);
             run(&small, &mut cache, &mut buffers, &sink).unwrap();
             drop(held);
@@ -609,21 +612,17 @@ mod tests {
             let mut opts = scene.settings();
             (opts.width, opts.height) = (w, h);
             opts.quality.precision = renderer;
-            let shown = Mutex::new(Vec::new());
-            let sink = |r: Report| match r {
-                Report::Frame(s) => shown.lock().unwrap().push(s),
-                Report::Failed { message, .. } => panic!("render failed: {message}"),
-            };
+            let shown = Collected::default();
             let tracer = render::make_tracer(&scene, &opts).unwrap();
             passes(
                 &job(&scene),
                 tracer.as_ref(),
                 &opts,
                 &mut Buffers::default(),
-                &sink,
+                &shown.sink(),
             )
             .unwrap();
-            let shown = shown.into_inner().unwrap();
+            let shown = shown.into_frames();
             assert_eq!(shown.len(), 2, "{renderer:?}");
             let (expected, _) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
             assert_eq!(*shown[1].frame, expected, "{renderer:?}");
@@ -728,14 +727,10 @@ mod tests {
         let (mut cache, mut buffers) = (TracerCache::default(), Buffers::default());
         let mut camera = CameraControl::new(&base);
         let mut view = |scene: &Scene, cache: &mut TracerCache, n: u64| {
-            let shown = Mutex::new(Vec::new());
-            let sink = |r: Report| match r {
-                Report::Frame(s) => shown.lock().unwrap().push(s),
-                Report::Failed { message, .. } => panic!("render failed: {message}"),
-            };
+            let shown = Collected::default();
             let job = Job::new(n, Arc::new(scene.clone()), (w, h), 4);
-            run(&job, cache, &mut buffers, &sink).unwrap();
-            let last = shown.into_inner().unwrap().pop().unwrap();
+            run(&job, cache, &mut buffers, &shown.sink()).unwrap();
+            let last = shown.into_frames().pop().unwrap();
             let mut opts = scene.settings();
             (opts.width, opts.height) = (w, h);
             let (expected, _) = render::render(scene, &opts, &RenderControl::default()).unwrap();
