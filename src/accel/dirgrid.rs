@@ -40,17 +40,37 @@ fn ordered_bits(x: f32) -> u32 {
     }
 }
 
+/// The number whose [`ordered_bits`] are `bits`.
+fn from_ordered_bits(bits: u32) -> f32 {
+    f32::from_bits(if bits >> 31 == 1 {
+        bits & !(1 << 31)
+    } else {
+        !bits
+    })
+}
+
 /// What a run of spheres adds to a grid.
 #[derive(Default)]
 struct Run {
     /// Spheres that contain the centre.
     always: Vec<u32>,
-    /// (cell, sphere) for every cell a sphere is seen in.
+    /// (cell, the sphere's place in the sorted order) for every cell a sphere is seen in.
     pairs: Vec<(u32, u32)>,
 }
 
-/// The cells around `centre` in which sphere `k` (`c`, `r`) is seen, into `out`.
-fn cells_of(centre: DVec3, c: DVec3, r: f64, n: u32, cones: &CellCones, k: u32, out: &mut Run) {
+/// The cells around `centre` in which sphere `k` (`c`, `r`) is seen, into `out` as pairs
+/// (cell, `place`).
+#[allow(clippy::too_many_arguments)]
+fn cells_of(
+    centre: DVec3,
+    c: DVec3,
+    r: f64,
+    n: u32,
+    cones: &CellCones,
+    k: u32,
+    place: u32,
+    out: &mut Run,
+) {
     let rel = c - centre;
     let reach = r * (1.0 + 1e-6) + 1e-9 * rel.abs().max_element();
     let dist = rel.length();
@@ -71,7 +91,7 @@ fn cells_of(centre: DVec3, c: DVec3, r: f64, n: u32, cones: &CellCones, k: u32, 
         for v in v0..=v1 {
             for u in u0..=u1 {
                 if cones.meets(face, u, v, &sphere_cone) {
-                    out.pairs.push((cell_index(face, u, v, n) as u32, k));
+                    out.pairs.push((cell_index(face, u, v, n) as u32, place));
                 }
             }
         }
@@ -86,53 +106,62 @@ impl DirGrid {
     /// Builds the grid around `centre` for spheres `(centre, radius)`.
     pub(super) fn build(centre: DVec3, spheres: &[(DVec3, f64)], n: u32) -> DirGrid {
         let faces = 6 * (n as usize) * (n as usize);
-        // Each sphere's nearest distance from the centre, rounded down so that the
-        // early exit of queries stays conservative.
-        let near_of: Vec<f32> = spheres
-            .iter()
-            .map(|&(c, r)| {
+        // Visit spheres nearest first: the stable fill below then leaves every cell's
+        // list sorted, so closest-hit queries can stop early. Sorted as one `u64` key a
+        // sphere (its nearest distance from the centre, rounded down so that the early
+        // exit of queries stays conservative, in order-preserving bits; then the index,
+        // which settles ties): a plain integer sort, no lookups from the comparison.
+        let mut keys: Vec<u64> = spheres
+            .par_iter()
+            .with_min_len(SPHERES_PER_RUN)
+            .enumerate()
+            .map(|(k, &(c, r))| {
                 let dist = (c - centre).length();
                 let d = (dist - r) - 1e-6 * (dist + r + centre.abs().max_element());
                 let f = d as f32;
-                if f64::from(f) > d {
-                    f.next_down()
-                } else {
-                    f
-                }
+                let near = if f64::from(f) > d { f.next_down() } else { f };
+                (u64::from(ordered_bits(near)) << 32) | k as u64
             })
-            .collect();
-        // Visit spheres nearest first: the stable fill below then leaves every cell's
-        // list sorted, so closest-hit queries can stop early. Sorted as one `u64` key a
-        // sphere (distance in order-preserving bits, then the index, which settles
-        // ties): a plain integer sort, no lookups from the comparison.
-        let mut keys: Vec<u64> = near_of
-            .iter()
-            .enumerate()
-            .map(|(k, &near)| (u64::from(ordered_bits(near)) << 32) | k as u64)
             .collect();
         if keys.len() >= PARALLEL_SORT {
             keys.par_sort_unstable();
         } else {
             keys.sort_unstable();
         }
-        let order: Vec<u32> = keys.into_iter().map(|key| key as u32).collect();
+        // The spheres gathered in that order, each with its entry (index and nearest
+        // distance, both read back from its key): the walk over runs below then reads
+        // memory in order, and the gather's loads, independent of each other, overlap
+        // (a million spheres are 32 MB, and a load in sorted order misses the caches).
+        let sorted: Vec<((DVec3, f64), (u32, f32))> = keys
+            .par_iter()
+            .map(|&key| {
+                let k = key as u32;
+                (
+                    spheres[k as usize],
+                    (k, from_ordered_bits((key >> 32) as u32)),
+                )
+            })
+            .collect();
+        drop(keys);
 
         let cones = CellCones::shared(n);
         // Each sphere's cells, in runs of spheres on rayon's threads; the runs come
-        // back in order, so the pairs stay nearest first.
-        let runs: Vec<Run> = order
+        // back in order, so the pairs stay nearest first. A pair names the sphere by
+        // its place in `sorted`.
+        let runs: Vec<Run> = sorted
             .par_chunks(SPHERES_PER_RUN)
-            .map(|run| {
+            .enumerate()
+            .map(|(i, run)| {
                 let mut out = Run::default();
-                for &k in run {
-                    let (c, r) = spheres[k as usize];
-                    cells_of(centre, c, r, n, &cones, k, &mut out);
+                for (j, &((c, r), (k, _))) in run.iter().enumerate() {
+                    let place = (i * SPHERES_PER_RUN + j) as u32;
+                    cells_of(centre, c, r, n, &cones, k, place, &mut out);
                 }
                 out
             })
             .collect();
         // Counting sort by cell (stable: keeps the nearest-first order), writing each
-        // entry with its nearest distance straight into place.
+        // entry straight into place.
         let mut offsets = vec![0u32; faces + 1];
         for &(cell, _) in runs.iter().flat_map(|run| &run.pairs) {
             offsets[cell as usize + 1] += 1;
@@ -142,8 +171,8 @@ impl DirGrid {
         }
         let mut fill = offsets.clone();
         let mut items = vec![(0u32, 0.0f32); offsets[faces] as usize];
-        for &(cell, k) in runs.iter().flat_map(|run| &run.pairs) {
-            items[fill[cell as usize] as usize] = (k, near_of[k as usize]);
+        for &(cell, place) in runs.iter().flat_map(|run| &run.pairs) {
+            items[fill[cell as usize] as usize] = sorted[place as usize].1;
             fill[cell as usize] += 1;
         }
         let always = runs.into_iter().flat_map(|run| run.always).collect();
@@ -352,7 +381,7 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
 
 #[cfg(test)]
 mod tests {
-    use super::ordered_bits;
+    use super::{from_ordered_bits, ordered_bits};
 
     /// The sort keys order numbers as `total_cmp` does, negatives and zeros included.
     #[test]
@@ -378,6 +407,38 @@ mod tests {
                     "{a} {b}"
                 );
             }
+        }
+    }
+
+    /// The keys give back the very bits they were made from (the grid's entries take
+    /// their distances from the sorted keys).
+    #[test]
+    fn ordered_bits_turn_back_into_the_same_number() {
+        let xs = [
+            f32::NEG_INFINITY,
+            f32::MIN,
+            -1.5,
+            -f32::MIN_POSITIVE / 4.0,
+            -0.0,
+            0.0,
+            f32::MIN_POSITIVE / 4.0,
+            1.0f32.next_down(),
+            3.25e7,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NAN,
+            -f32::NAN,
+        ];
+        for x in xs {
+            assert_eq!(
+                from_ordered_bits(ordered_bits(x)).to_bits(),
+                x.to_bits(),
+                "{x}"
+            );
+        }
+        // Every bit pattern's key is distinct, so the inverse is the only one.
+        for bits in [0u32, 1, 0x7f80_0000, 0x8000_0000, 0xffff_ffff, 0x1234_5678] {
+            assert_eq!(ordered_bits(from_ordered_bits(bits)), bits, "{bits:#x}");
         }
     }
 }

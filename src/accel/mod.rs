@@ -178,15 +178,18 @@ pub(crate) struct Spheres {
 impl Spheres {
     /// The spheres with a hierarchy for rays of any origin.
     pub(crate) fn new(spheres: &[Sphere]) -> Self {
-        let center: Vec<DVec3> = spheres.iter().map(|s| s.center).collect();
-        let radius: Vec<f64> = spheres.iter().map(|s| s.radius).collect();
+        let center: Vec<DVec3> = spheres.par_iter().map(|s| s.center).collect();
+        let radius: Vec<f64> = spheres.par_iter().map(|s| s.radius).collect();
         let quick: Vec<Vec4> = center
             .par_iter()
             .zip(&radius)
             .map(|(&c, &r)| quick_sphere(c, r))
             .collect();
         let bvh = Bvh::build(spheres.len(), |k| sphere_box(center[k], radius[k]));
-        let inside = (0..spheres.len()).map(|_| OnceLock::new()).collect();
+        let inside = (0..spheres.len())
+            .into_par_iter()
+            .map(|_| OnceLock::new())
+            .collect();
         let leaf = bvh
             .items()
             .par_iter()
@@ -203,7 +206,7 @@ impl Spheres {
         Spheres {
             bvh,
             leaf,
-            inv_radius: radius.iter().map(|r| 1.0 / r).collect(),
+            inv_radius: radius.par_iter().map(|r| 1.0 / r).collect(),
             center,
             radius,
             quick,
@@ -241,7 +244,7 @@ impl Spheres {
         lights: &[DVec3],
         eye: DVec3,
     ) -> (Spheres, EyeGrid) {
-        let list: Vec<(DVec3, f64)> = spheres.iter().map(|s| (s.center, s.radius)).collect();
+        let list: Vec<(DVec3, f64)> = spheres.par_iter().map(|s| (s.center, s.radius)).collect();
         let n = grid_resolution(list.len());
         let points: Vec<DVec3> = std::iter::once(eye).chain(lights.iter().copied()).collect();
         let (base, grids) = rayon::join(

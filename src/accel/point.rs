@@ -4,6 +4,7 @@
 //! The answers are those of the general queries of [`Spheres`], to the bit.
 
 use glam::{DVec3, Vec3, Vec4};
+use rayon::prelude::*;
 
 use super::dirgrid::DirGrid;
 use super::{round_up, unit64, Best, Hit, Query, Ray, Spheres, QUICK_SLACK};
@@ -175,7 +176,7 @@ impl Spheres {
         let point = grid.centre;
         let quick = self
             .center
-            .iter()
+            .par_iter()
             .zip(&self.quick)
             .map(|(&c, &q)| PointQuick::new(point, c, q))
             .collect();
@@ -192,8 +193,8 @@ impl Spheres {
         let point = self.point_grid(grid);
         let exact = point
             .quick
-            .iter()
-            .zip(self.center.iter().zip(&self.radius))
+            .par_iter()
+            .zip(self.center.par_iter().zip(&self.radius))
             .map(|(&quick, (&c, &radius))| {
                 let f = eye - c;
                 EyeSphere {
