@@ -58,6 +58,18 @@ struct Run {
     pairs: Vec<(u32, u32)>,
 }
 
+impl Run {
+    /// Room for `spheres` spheres of many cells each, so that the pairs are not copied
+    /// as they grow: the room a run does not use is never touched, and untouched
+    /// memory costs no page fault.
+    fn with_room_for(spheres: usize) -> Run {
+        Run {
+            always: Vec::new(),
+            pairs: Vec::with_capacity(16 * spheres),
+        }
+    }
+}
+
 /// The cells around `centre` in which sphere `k` (`c`, `r`) is seen, into `out` as pairs
 /// (cell, `place`).
 #[allow(clippy::too_many_arguments)]
@@ -152,7 +164,7 @@ impl DirGrid {
             .par_chunks(SPHERES_PER_RUN)
             .enumerate()
             .map(|(i, run)| {
-                let mut out = Run::default();
+                let mut out = Run::with_room_for(run.len());
                 for (j, &((c, r), (k, _))) in run.iter().enumerate() {
                     let place = (i * SPHERES_PER_RUN + j) as u32;
                     cells_of(centre, c, r, n, &cones, k, place, &mut out);
