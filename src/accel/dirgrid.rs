@@ -9,6 +9,8 @@
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
+use super::view::ViewPyramid;
+
 pub(super) struct DirGrid {
     /// The point every ray of the grid passes through.
     pub(super) centre: DVec3,
@@ -115,8 +117,14 @@ fn cells_of(
 const WIDEN: f64 = 1e-4;
 
 impl DirGrid {
-    /// Builds the grid around `centre` for spheres `(centre, radius)`.
-    pub(super) fn build(centre: DVec3, spheres: &[(DVec3, f64)], n: u32) -> DirGrid {
+    /// Builds the grid around `centre` for spheres `(centre, radius)`; with `view`, for
+    /// rays through it only: the spheres wholly outside it are left out.
+    pub(super) fn build(
+        centre: DVec3,
+        spheres: &[(DVec3, f64)],
+        n: u32,
+        view: Option<&ViewPyramid>,
+    ) -> DirGrid {
         let faces = 6 * (n as usize) * (n as usize);
         // Visit spheres nearest first: the stable fill below then leaves every cell's
         // list sorted, so closest-hit queries can stop early. Sorted as one `u64` key a
@@ -127,6 +135,7 @@ impl DirGrid {
             .par_iter()
             .with_min_len(SPHERES_PER_RUN)
             .enumerate()
+            .filter(|&(_, &(c, r))| view.is_none_or(|view| view.may_see(c - centre, r)))
             .map(|(k, &(c, r))| {
                 let dist = (c - centre).length();
                 let d = (dist - r) - 1e-6 * (dist + r + centre.abs().max_element());

@@ -5,6 +5,7 @@
 mod bvh;
 mod dirgrid;
 mod point;
+mod view;
 
 use std::sync::OnceLock;
 
@@ -14,6 +15,7 @@ use rayon::prelude::*;
 use bvh::{Aabb, Bvh};
 use dirgrid::DirGrid;
 pub(crate) use point::{EyeGrid, PointGrid};
+pub(crate) use view::ViewPyramid;
 
 use crate::intersect::roots;
 use crate::model::Side;
@@ -232,17 +234,19 @@ impl Spheres {
         let n = grid_resolution(list.len());
         self.lights = lights
             .par_iter()
-            .map(|&p| self.point_grid(DirGrid::build(p, &list, n)))
+            .map(|&p| self.point_grid(DirGrid::build(p, &list, n, None)))
             .collect();
         self
     }
 
     /// The spheres with their hierarchy and light grids, and the eye grid of a first
-    /// camera, built side by side on the pool's threads (they are independent).
+    /// camera (see [`Spheres::eye_grid`]), built side by side on the pool's threads
+    /// (they are independent).
     pub(crate) fn build_for_view(
         spheres: &[Sphere],
         lights: &[DVec3],
         eye: DVec3,
+        view: Option<&ViewPyramid>,
     ) -> (Spheres, EyeGrid) {
         let list: Vec<(DVec3, f64)> = spheres.par_iter().map(|s| (s.center, s.radius)).collect();
         let n = grid_resolution(list.len());
@@ -254,7 +258,13 @@ impl Spheres {
                 points
                     .par_iter()
                     .enumerate()
-                    .map(|(i, &p)| DirGrid::build(p, &list, if i == 0 { eye_n } else { n }))
+                    .map(|(i, &p)| {
+                        if i == 0 {
+                            DirGrid::build(p, &list, eye_n, view)
+                        } else {
+                            DirGrid::build(p, &list, n, None)
+                        }
+                    })
                     .collect::<Vec<_>>()
             },
         );
@@ -280,10 +290,11 @@ impl Spheres {
     }
 
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
-    /// the only part of the structures that depends on the camera.
-    pub(crate) fn eye_grid(&self, eye: DVec3) -> EyeGrid {
+    /// the only part of the structures that depends on the camera. With `view`, it
+    /// answers rays through that pyramid only (a camera's primary rays).
+    pub(crate) fn eye_grid(&self, eye: DVec3, view: Option<&ViewPyramid>) -> EyeGrid {
         let list = self.centres_and_radii();
-        self.eye_point_grid(DirGrid::build(eye, &list, eye_resolution(list.len())))
+        self.eye_point_grid(DirGrid::build(eye, &list, eye_resolution(list.len()), view))
     }
 
     pub(crate) fn len(&self) -> usize {

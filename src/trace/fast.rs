@@ -8,7 +8,7 @@ use glam::{DVec3, Vec3};
 
 use super::row::{self, RowCamera, RUN};
 use super::{RayCounts, SampleTracer};
-use crate::accel::{EyeGrid, Hit, Query, Spheres};
+use crate::accel::{EyeGrid, Hit, Query, Spheres, ViewPyramid};
 use crate::camera::Camera;
 use crate::model::{self, Branches, Side};
 use crate::scene::Scene;
@@ -57,6 +57,16 @@ pub struct FastTracer {
     cutoff: f32,
 }
 
+/// The directions of `camera`'s primary rays, the only rays its eye grid answers.
+fn view_of(camera: &Camera) -> Option<ViewPyramid> {
+    ViewPyramid::new(
+        camera.origin,
+        camera.lower_left,
+        camera.horizontal,
+        camera.vertical,
+    )
+}
+
 /// What a sample skipped under the contribution cutoff.
 #[derive(Clone, Copy, Debug, Default)]
 struct Skipped {
@@ -67,7 +77,12 @@ impl FastTracer {
     /// Compiles `scene` for `camera`, tracing to depth `max_depth`.
     pub fn new(scene: &Scene, camera: &Camera, max_depth: u32) -> Self {
         let lights: Vec<DVec3> = scene.lights.iter().map(|l| l.position).collect();
-        let (spheres, eye) = Spheres::build_for_view(&scene.spheres, &lights, camera.origin);
+        let (spheres, eye) = Spheres::build_for_view(
+            &scene.spheres,
+            &lights,
+            camera.origin,
+            view_of(camera).as_ref(),
+        );
         let compiled = Compiled {
             spheres,
             materials: scene
@@ -121,7 +136,10 @@ impl FastTracer {
     /// The same scene seen by another camera (and depth): shares the compiled scene and
     /// rebuilds only the camera's grid, so views of one scene compile it once.
     pub fn with_camera(&self, camera: &Camera, max_depth: u32) -> Self {
-        let eye = self.compiled.spheres.eye_grid(camera.origin);
+        let eye = self
+            .compiled
+            .spheres
+            .eye_grid(camera.origin, view_of(camera).as_ref());
         Self::with_compiled(Arc::clone(&self.compiled), eye, camera, max_depth)
             .with_cutoff(self.cutoff)
     }

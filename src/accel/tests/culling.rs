@@ -138,7 +138,7 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                 let eye = eye_dir * eye_dist;
                 let light = light_dir * (eye_dist * 3.0);
                 let set = Spheres::new(&spheres).with_light_grids(&[light]);
-                let eye_grid = set.eye_grid(eye);
+                let eye_grid = set.eye_grid(eye, None);
                 let mut c = counts.borrow_mut();
                 for &(u, pick, spread) in &rays {
                     // Aimed within 1.3 radii of a random sphere's centre: hits, misses
@@ -223,6 +223,124 @@ fn culling_never_loses_a_hit_or_an_occluder() {
     );
 }
 
+/// A camera's eye grid leaves out the spheres outside its view, and loses none that a
+/// primary ray meets: through every part of the film (its corners and edges too, the
+/// directions rounded as the tracer rounds them), the grid of the camera's view gives
+/// the same hits, to the bit, as the grid of every sphere (itself checked against brute
+/// force above).
+#[test]
+fn a_camera_s_eye_grid_keeps_every_sphere_its_film_sees() {
+    use crate::accel::ViewPyramid;
+    use crate::camera::{Camera, CameraSpec};
+    // (rays, hits, spheres left out, spheres kept)
+    let counts = RefCell::new((0u64, 0u64, 0usize, 0usize));
+    let film = prop::collection::vec((0.0f64..1.0, 0.0f64..1.0, 0u8..4), 48);
+    runner(200)
+        .run(
+            &(
+                world(),
+                log_uniform(-1.0, 4.0),
+                unit_vector(),
+                unit_vector(),
+                10.0f64..170.0,
+                (1u32..2000, 1u32..2000),
+                film,
+            ),
+            |(mut spheres, eye_dist, eye_dir, look, vfov, (width, height), film)| {
+                let eye = eye_dir * eye_dist;
+                let spec = CameraSpec::LookAt {
+                    look_from: eye,
+                    look_at: eye + look,
+                    up: if look.y.abs() < 0.9 {
+                        DVec3::Y
+                    } else {
+                        DVec3::X
+                    },
+                    vfov,
+                };
+                let camera = Camera::new(&spec, width, height).expect("a valid camera");
+                let view = ViewPyramid::new(
+                    camera.origin,
+                    camera.lower_left,
+                    camera.horizontal,
+                    camera.vertical,
+                )
+                .expect("a look-at camera makes a pyramid");
+                // Four spheres centred just outside the film's four edges, each
+                // reaching 1e-4 of the film in (its silhouette touches the direction
+                // through that point), and the edge rays that meet them: a grid that
+                // trims its view by more than that loses them.
+                let film_dir = |s: f64, t: f64| {
+                    camera.lower_left + s * camera.horizontal + t * camera.vertical - eye
+                };
+                let mut edge_rays = Vec::new();
+                for (side, &(a, b, _)) in film.iter().take(4).enumerate() {
+                    const OUT: f64 = 0.005;
+                    const IN: f64 = 1e-4;
+                    let (centre, reach, edge) = match side {
+                        0 => ((-OUT, b), (IN, b), (0.0, b)),
+                        1 => ((1.0 + OUT, b), (1.0 - IN, b), (1.0, b)),
+                        2 => ((a, -OUT), (a, IN), (a, 0.0)),
+                        _ => ((a, 1.0 + OUT), (a, 1.0 - IN), (a, 1.0)),
+                    };
+                    let towards = film_dir(centre.0, centre.1).normalize();
+                    let dist = 1.0 + 5.0 * a;
+                    // The sine of the angle to the reach direction, times the distance.
+                    let r = dist
+                        * towards
+                            .cross(film_dir(reach.0, reach.1).normalize())
+                            .length();
+                    spheres.push(Sphere::new(eye + towards * dist, r));
+                    edge_rays.push(edge);
+                }
+                let set = Spheres::new(&spheres);
+                let all = set.eye_grid(eye, None);
+                let seen = set.eye_grid(eye, Some(&view));
+                let outside = spheres
+                    .iter()
+                    .filter(|s| !view.may_see(s.center - eye, s.radius))
+                    .count();
+                let mut c = counts.borrow_mut();
+                c.2 += outside;
+                c.3 += spheres.len() - outside;
+                let corner = (camera.lower_left - camera.origin).as_vec3();
+                let (h, v) = (camera.horizontal.as_vec3(), camera.vertical.as_vec3());
+                // Film coordinates on an edge or at a corner three times in four.
+                let on_film = film.iter().map(|&(a, b, edge)| match edge {
+                    0 => (a, b),
+                    1 => (a.round(), b),
+                    2 => (a, b.round()),
+                    _ => (a.round(), b.round()),
+                });
+                for (s, t) in on_film.chain(edge_rays) {
+                    let dir = crate::model::primary_direction(corner, h, v, s as f32, t as f32);
+                    let q = Query {
+                        origin: eye,
+                        dir,
+                        from: None,
+                    };
+                    let key = |hit: Option<Hit>| hit.map(|h| (h.sphere, h.point, h.normal));
+                    let want = key(set.closest_primary(&all, &q));
+                    prop_assert_eq!(key(set.closest_primary(&seen, &q)), want);
+                    prop_assert_eq!(
+                        key(set.closest_from_eye(&seen, dir)),
+                        key(set.closest_from_eye(&all, dir))
+                    );
+                    c.0 += 1;
+                    c.1 += u64::from(want.is_some());
+                }
+                Ok(())
+            },
+        )
+        .unwrap();
+    let (rays, hits, left_out, kept) = counts.into_inner();
+    println!("view grids: {rays} rays ({hits} hits); {left_out} spheres left out, {kept} kept");
+    assert!(
+        hits > 500 && left_out > 5000 && kept > 5000,
+        "{hits} {left_out} {kept}"
+    );
+}
+
 /// The tracer's sky runs: when `eye_sees_nothing_between` says a row of directions sees
 /// only sky, every direction between (as a row of pixels computes them) misses every
 /// sphere, by brute force in `f64`, and the eye query agrees.
@@ -238,7 +356,7 @@ fn sky_runs_see_no_sphere() {
                 let spheres = &spheres[..spheres.len().min(12)];
                 let eye = eye_dir * eye_dist;
                 let set = Spheres::new(spheres);
-                let grid = set.eye_grid(eye);
+                let grid = set.eye_grid(eye, None);
                 let mut c = counts.borrow_mut();
                 for &(base, across, span) in &runs {
                     // A row: corner + s·h with s in [0, 1], as the camera forms it.
@@ -289,7 +407,7 @@ fn rows_in_one_cell_get_the_per_ray_hits() {
             |(spheres, eye_dist, eye_dir, runs)| {
                 let eye = eye_dir * eye_dist;
                 let set = Spheres::new(&spheres);
-                let grid = set.eye_grid(eye);
+                let grid = set.eye_grid(eye, None);
                 let mut c = counts.borrow_mut();
                 for &(pick, across, span) in &runs {
                     // A row through a random sphere, as the camera forms it.
@@ -415,7 +533,7 @@ fn large_scenes_lose_no_hit_or_occluder() {
     let light = scene.lights[0].position;
     let eye = DVec3::new(0.0, 18.0, 60.0);
     let set = Spheres::new(spheres).with_light_grids(&[light]);
-    let eye_grid = set.eye_grid(eye);
+    let eye_grid = set.eye_grid(eye, None);
     // A fixed sequence of rays, each aimed within 1.3 radii of a sphere's centre.
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = || {
