@@ -37,11 +37,13 @@ impl Aabb {
     }
 }
 
-/// An item as the build moves it: its box and its index.
+/// An item as the build moves it: its box, its index, and its bin in the split being
+/// made (in what would otherwise be padding).
 #[derive(Clone, Copy)]
 struct BuildItem {
     bounds: Aabb,
     index: u32,
+    bin: u32,
 }
 
 impl BuildItem {
@@ -122,6 +124,7 @@ impl Bvh {
             .map(|k| BuildItem {
                 bounds: bounds(k),
                 index: k as u32,
+                bin: 0,
             })
             .collect();
         let mut binary = Vec::with_capacity(2 * len.max(1));
@@ -391,25 +394,20 @@ impl Bounds {
     }
 }
 
-/// A split of a node's items: those in bins `..=last_left` on `axis` go left. The
-/// bounds of both sides come from the bins, so no child measures its items again.
+/// A split of a node's items: those in bins `..=last_left` on `axis` go left (each
+/// item's bin is written into it as it is binned). The bounds of both sides come from
+/// the bins, so no child measures its items again.
 struct Split {
     axis: usize,
-    /// The bin of a centre coordinate `x` is `((x − lo)·scale)`, at most `BINS − 1`.
-    lo: f32,
-    scale: f32,
-    last_left: usize,
+    last_left: u32,
     left: Bounds,
     right: Bounds,
 }
 
 impl Split {
-    /// `bin_of(x) <= last_left` without the cast: the bin is the integer part of
-    /// `(x − lo)·scale` (0 for NaN), and `last_left < BINS − 1`.
     #[inline]
     fn goes_left(&self, item: &BuildItem) -> bool {
-        let at = (item.centre_on(self.axis) - self.lo) * self.scale;
-        at < (self.last_left + 1) as f32 || at.is_nan()
+        item.bin <= self.last_left
     }
 }
 
@@ -497,7 +495,7 @@ fn offset(mut n: Node, base: u32) -> Node {
 }
 
 /// The binned-SAH split, or `None` when a leaf is cheaper (or the centres coincide).
-fn best_split(items: &[BuildItem], bounds: &Bounds) -> Option<Split> {
+fn best_split(items: &mut [BuildItem], bounds: &Bounds) -> Option<Split> {
     // Bin along the axis where the centres spread most (a third of the work of trying
     // all three, for trees nearly as good).
     let centres = &bounds.centres;
@@ -510,20 +508,22 @@ fn best_split(items: &[BuildItem], bounds: &Bounds) -> Option<Split> {
     let scale = BINS as f32 / (hi - lo);
     let mut bins = [Bounds::EMPTY; BINS];
     let mut bin_count = [0u32; BINS];
-    for item in items {
+    for item in items.iter_mut() {
         let b = bin_of(item.centre_on(axis), lo, scale);
         bins[b].add(item);
         bin_count[b] += 1;
+        item.bin = b as u32;
     }
-    // Sweep from the right, then from the left, evaluating the cost of each plane.
-    let mut right_bounds = [Bounds::EMPTY; BINS];
+    // Sweep from the right, keeping each plane's right-hand cost and count, then from
+    // the left, evaluating the cost of each plane.
+    let mut right_cost = [0f32; BINS];
     let mut right_count = [0u32; BINS];
     let mut acc = Bounds::EMPTY;
     let mut n = 0;
     for b in (1..BINS).rev() {
         acc.grow(&bins[b]);
         n += bin_count[b];
-        right_bounds[b] = acc;
+        right_cost[b] = acc.boxes.half_area() * n as f32;
         right_count[b] = n;
     }
     let mut best: Option<(f32, usize, Bounds)> = None;
@@ -535,22 +535,21 @@ fn best_split(items: &[BuildItem], bounds: &Bounds) -> Option<Split> {
         if n == 0 || right_count[b + 1] == 0 {
             continue;
         }
-        let cost = acc.boxes.half_area() * n as f32
-            + right_bounds[b + 1].boxes.half_area() * right_count[b + 1] as f32;
+        let cost = acc.boxes.half_area() * n as f32 + right_cost[b + 1];
         if best.is_none_or(|(c, _, _)| cost < c) {
             best = Some((cost, b, acc));
         }
     }
     let (cost, last_left, left) = best?;
+    let mut right = Bounds::EMPTY;
+    bins[last_left + 1..].iter().for_each(|bin| right.grow(bin));
     // A leaf costs one test per item; an inner node about one box test plus its children.
     let leaf_cost = bounds.boxes.half_area() * items.len() as f32;
     (cost < leaf_cost || items.len() > LARGEST_LEAF).then_some(Split {
         axis,
-        lo,
-        scale,
-        last_left,
+        last_left: last_left as u32,
         left,
-        right: right_bounds[last_left + 1],
+        right,
     })
 }
 
