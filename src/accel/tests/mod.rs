@@ -12,7 +12,7 @@ use glam::DVec3;
 use proptest::strategy::Strategy;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
-use super::{round_up, Query};
+use super::{list_radius, round_up, Query, WALK_INSIDE_FROM};
 use crate::model::Side;
 
 /// A proptest runner of `cases` cases with a fixed seed and no persisted failures.
@@ -147,4 +147,20 @@ fn round_up_is_the_least_f32_not_below() {
         assert_eq!(up.to_bits(), want.to_bits(), "t = {t:e}");
         assert!(t.is_nan() || f64::from(up) >= t, "t = {t:e}");
     }
+}
+
+/// Every sphere of a scene up to `WALK_INSIDE_FROM` spheres keeps its list of
+/// overlapping spheres; in a larger one, those of more than twice the median radius.
+#[test]
+fn only_large_spheres_of_large_scenes_keep_lists() {
+    let mut radii = vec![0.25; WALK_INSIDE_FROM];
+    radii[7] = 1000.0;
+    assert_eq!(list_radius(&radii), 0.0);
+    // One more sphere: 2^18 + 1 radii, the median (the 2^17-th from 0) is 0.25.
+    radii.push(3.0);
+    assert_eq!(list_radius(&radii), 0.5);
+    // Half the spheres larger: the median moves to the larger radius.
+    let n = radii.len();
+    radii[..n / 2 + 1].fill(2.0);
+    assert_eq!(list_radius(&radii), 4.0);
 }
