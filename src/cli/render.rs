@@ -136,11 +136,25 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
         )
     });
 
-    let result = render::render(&scene, &opts, &control);
+    // Files of bytes only (not parts, which record their place): rendered straight
+    // into bytes, with no linear frame.
+    let is_part = opts.region.is_some() || opts.tile.is_some();
+    let bytes_only = !is_part && targets.iter().all(|(_, f)| *f != Format::Exr);
+    let result = if bytes_only {
+        let encoder = image_io::ByteEncoder::new(opts.encoding);
+        render::render_bytes(&scene, &opts, &control, |c| encoder.byte(c)).map(|(bytes, stats)| {
+            let image = image::RgbImage::from_raw(area.width, area.height, bytes)
+                .expect("the buffer has w*h*3 bytes");
+            (Rendered::Bytes(image), stats)
+        })
+    } else {
+        render::render(&scene, &opts, &control)
+            .map(|(frame, stats)| (Rendered::Frame(frame), stats))
+    };
     if let Some(progress) = progress {
         progress.finish();
     }
-    let (frame, stats) = result.map_err(|e| match e {
+    let (rendered, stats) = result.map_err(|e| match e {
         render::RenderError::Cancelled => anyhow!("interrupted: no file was written"),
         other => anyhow!(other),
     })?;
@@ -152,12 +166,13 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
                 path.display()
             ));
         }
-        let is_part = opts.region.is_some() || opts.tile.is_some();
-        if is_part && matches!(format, Format::Png | Format::Exr) {
-            let placement = Placement::of(&scene, &opts);
-            parts::save_part(&frame, &placement, path, *format, opts.encoding)?;
-        } else {
-            image_io::save(&frame, path, *format, opts.encoding)?;
+        match &rendered {
+            Rendered::Bytes(image) => image_io::save_rgb8(image, path, *format)?,
+            Rendered::Frame(frame) if is_part && matches!(format, Format::Png | Format::Exr) => {
+                let placement = Placement::of(&scene, &opts);
+                parts::save_part(frame, &placement, path, *format, opts.encoding)?;
+            }
+            Rendered::Frame(frame) => image_io::save(frame, path, *format, opts.encoding)?,
         }
         if !args.quiet {
             eprintln!("wrote {}", path.display());
@@ -176,6 +191,14 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// A render as the files to write need it.
+enum Rendered {
+    /// Linear values (EXR, parts).
+    Frame(render::Frame),
+    /// 8-bit RGB, top row first, in the settings' encoding.
+    Bytes(image::RgbImage),
 }
 
 /// What the closing line says of the samples and the depth: "16 spp, depth 5", or

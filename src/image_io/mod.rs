@@ -140,29 +140,13 @@ pub fn to_rgb8(frame: &Frame, encoding: Encoding) -> RgbImage {
     let (w, h) = (frame.width, frame.height);
     // One loop per encoding, each with its conversion inlined.
     let bytes = match ByteEncoder::new(encoding) {
-        ByteEncoder::Linear => rgb8_bytes(frame, to_byte),
-        ByteEncoder::Srgb(table) => rgb8_bytes(frame, |c| table.byte(c)),
+        ByteEncoder::Linear => frame.bytes_top_first(to_byte),
+        ByteEncoder::Srgb(table) => frame.bytes_top_first(|c| table.byte(c)),
     };
     RgbImage::from_raw(w, h, bytes).expect("the buffer has w*h*3 bytes")
 }
 
-fn rgb8_bytes(frame: &Frame, byte: impl Fn(f32) -> u8 + Sync) -> Vec<u8> {
-    let w = frame.width.max(1) as usize;
-    let mut bytes = vec![0u8; frame.pixels.len() * 3];
-    // Rows in parallel: a 1280x720 frame's bytes take a few milliseconds on one core.
-    bytes
-        .par_chunks_mut(w * 3)
-        .zip(frame.pixels.par_chunks_exact(w).rev())
-        .with_min_len(ROWS_PER_TASK)
-        .for_each(|(out, row)| {
-            for (o, p) in out.chunks_exact_mut(3).zip(row) {
-                o.copy_from_slice(&[byte(p.x), byte(p.y), byte(p.z)]);
-            }
-        });
-    bytes
-}
-
-/// Rows converted by one task of [`rgb8_bytes`] and [`to_rgb32f`] at least.
+/// Rows converted by one task of [`to_rgb32f`] at least.
 const ROWS_PER_TASK: usize = 32;
 
 /// The frame as linear 32-bit float RGB, row 0 at the top.

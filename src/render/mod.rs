@@ -28,10 +28,11 @@ use crate::trace::fast::FastTracer;
 use crate::trace::reference::ReferenceTracer;
 use crate::trace::{RayCounts, SampleTracer};
 use adaptive::adaptive;
-use bands::{for_each_pixel, for_each_row, in_pool, BAND_ROWS};
+use bands::{for_each_pixel, for_each_row, for_each_row_from_top, in_pool, BAND_ROWS};
 use film::{centre_height, film, pixel_centres};
 
 pub use adaptive::first_pass_samples;
+use frame::bytes_of_row;
 pub use frame::Frame;
 pub use progressive::{accumulate, accumulate_first};
 pub use resolve::{mend_non_finite, pixel_value, pixel_values, resolve};
@@ -191,6 +192,72 @@ pub fn render(
 ) -> Result<(Frame, RenderStats), RenderError> {
     let r = render_bounded(scene, settings, control)?;
     Ok((r.frame, r.stats))
+}
+
+/// Renders the area of `settings` with all its samples into 8-bit RGB, top row first,
+/// `byte` turning each linear value into its byte (an encoding's conversion): to the
+/// byte what [`render`] and then [`Frame::bytes_top_first`] give. A render of one
+/// sample a pixel that skips nothing converts each row as it traces it and keeps no
+/// linear frame (11 MB at 1280×720, whose fresh pages cost a tenth of a cold render
+/// of hw3); any other renders the frame, then converts it.
+pub fn render_bytes(
+    scene: &Scene,
+    settings: &Settings,
+    control: &RenderControl,
+    byte: impl Fn(f32) -> u8 + Sync,
+) -> Result<(Vec<u8>, RenderStats), RenderError> {
+    let quality = &settings.quality;
+    let adaptive = matches!(quality.adaptive, Some(a) if a.first < quality.spp);
+    let skips = quality.cutoff != 0.0 && quality.precision != Precision::Reference;
+    if quality.spp != 1 || adaptive || skips {
+        let (frame, stats) = render(scene, settings, control)?;
+        return Ok((frame.bytes_top_first(byte), stats));
+    }
+    settings.check()?;
+    let start = Instant::now();
+    let camera = scene.camera(settings.width, settings.height)?;
+    let tracer = in_pool(settings, || Tracer::new(scene, camera, settings, None))?;
+    let build_seconds = start.elapsed().as_secs_f64();
+    let (bytes, rays) = match &tracer {
+        Tracer::Fast(t) => one_sample_rgb8(t, settings, control, &byte)?,
+        Tracer::Reference(t) => one_sample_rgb8(t, settings, control, &byte)?,
+    };
+    let stats = RenderStats {
+        rays,
+        seconds: start.elapsed().as_secs_f64(),
+        build_seconds,
+    };
+    Ok((bytes, stats))
+}
+
+/// The one-sample pass of [`render_with`], each row converted to bytes by `byte` as
+/// soon as it is traced, top row first.
+fn one_sample_rgb8<T: SampleTracer>(
+    tracer: &T,
+    settings: &Settings,
+    control: &RenderControl,
+    byte: &(impl Fn(f32) -> u8 + Sync),
+) -> Result<(Vec<u8>, RayCounts), RenderError> {
+    let area = settings.area();
+    let n = area.width as usize * area.height as usize;
+    control.set_samples_total(n as u64);
+    let mut bytes = vec![0u8; 3 * n];
+    let centres = pixel_centres(settings, area);
+    let rays = for_each_row_from_top(
+        settings,
+        area,
+        &mut bytes,
+        3,
+        1,
+        control,
+        |j, out, counts| {
+            let mut row = vec![Vec3::ZERO; centres.len()];
+            tracer.sample_row(&centres, centre_height(settings, j), &mut row, counts);
+            mend_non_finite(&mut row);
+            bytes_of_row(&row, out, byte);
+        },
+    )?;
+    Ok((bytes, rays))
 }
 
 /// Renders the area of `settings` and reports the cutoff's error bound per pixel and how
@@ -514,6 +581,64 @@ mod tests {
                 black > 50 && sane > 20 && black + sane == 200,
                 "spp {spp}: {black} {sane}"
             );
+        }
+    }
+
+    /// Bytes straight from the rows are the frame path's bytes (the frame, then
+    /// `to_rgb8`): one sample a pixel (rows converted as they are traced) in both
+    /// encodings, a region away from every edge, the reference tracer, and the renders
+    /// that make a frame first (4 samples, a cutoff).
+    #[test]
+    fn bytes_straight_from_the_rows_are_the_frame_s_bytes() {
+        use crate::image_io::{to_rgb8, ByteEncoder, Encoding};
+        let scene = crate::scene::hw3_scene(0);
+        let mut base = scene.settings();
+        (base.width, base.height) = (64, 36);
+        let with = |change: &dyn Fn(&mut Settings)| {
+            let mut s = base.clone();
+            change(&mut s);
+            s
+        };
+        let cases = [
+            ("one sample", with(&|_| {}), Encoding::Linear),
+            ("one sample, sRGB", with(&|_| {}), Encoding::Srgb),
+            (
+                "a region",
+                with(&|s| {
+                    s.region = Some(Region {
+                        x: 5,
+                        y: 3,
+                        width: 40,
+                        height: 20,
+                    })
+                }),
+                Encoding::Linear,
+            ),
+            (
+                "reference",
+                with(&|s| s.quality.precision = Precision::Reference),
+                Encoding::Srgb,
+            ),
+            ("4 samples", with(&|s| s.quality.spp = 4), Encoding::Linear),
+            (
+                "a cutoff",
+                with(&|s| s.quality.cutoff = 0.05),
+                Encoding::Linear,
+            ),
+        ];
+        for (name, settings, encoding) in cases {
+            let (frame, _) = render(&scene, &settings, &RenderControl::default()).unwrap();
+            let want = to_rgb8(&frame, encoding);
+            let encoder = ByteEncoder::new(encoding);
+            let (got, stats) = render_bytes(&scene, &settings, &RenderControl::default(), |c| {
+                encoder.byte(c)
+            })
+            .unwrap();
+            assert!(got == *want.as_raw(), "{name}: the bytes differ");
+            // Not a blank picture: the top row (sky) and the bottom row (ground) differ.
+            let rows: Vec<&[u8]> = got.chunks(3 * want.width() as usize).collect();
+            assert_ne!(rows[0], rows[rows.len() - 1], "{name}");
+            assert!(stats.rays.primary > 0, "{name}");
         }
     }
 }
