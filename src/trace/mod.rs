@@ -36,6 +36,8 @@ impl RayCounts {
 /// Something that computes the linear RGB of one sample.
 pub trait SampleTracer: Sync {
     /// The colour of the ray through film position `(s, t)` ∈ [0,1]² (`t` from the bottom).
+    /// Positions outside the film are outside the camera's view, which the fast
+    /// tracer's eye grid is built for (it lists only the spheres reaching into it).
     fn sample(&self, s: f32, t: f32, counts: &mut RayCounts) -> Vec3;
 
     /// The sample and a bound of its error from skipped work (quality settings such as
