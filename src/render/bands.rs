@@ -59,55 +59,14 @@ where
     T: Send,
     F: Fn(u32, &mut [T], &mut RayCounts) + Sync,
 {
-    rows_in_order(
-        settings, area, states, per_pixel, samples, control, false, row,
-    )
-}
-
-/// [`for_each_row`] with `states` holding the area's rows TOP row first (the order of
-/// files and screens).
-pub(super) fn for_each_row_from_top<T, F>(
-    settings: &Settings,
-    area: Region,
-    states: &mut [T],
-    per_pixel: usize,
-    samples: u64,
-    control: &RenderControl,
-    row: F,
-) -> Result<RayCounts, RenderError>
-where
-    T: Send,
-    F: Fn(u32, &mut [T], &mut RayCounts) + Sync,
-{
-    rows_in_order(
-        settings, area, states, per_pixel, samples, control, true, row,
-    )
-}
-
-#[allow(clippy::too_many_arguments)]
-fn rows_in_order<T, F>(
-    settings: &Settings,
-    area: Region,
-    states: &mut [T],
-    per_pixel: usize,
-    samples: u64,
-    control: &RenderControl,
-    from_top: bool,
-    row: F,
-) -> Result<RayCounts, RenderError>
-where
-    T: Send,
-    F: Fn(u32, &mut [T], &mut RayCounts) + Sync,
-{
     let aw = area.width as usize;
     assert_eq!(
         states.len(),
         aw * area.height as usize * per_pixel,
         "states must cover the area"
     );
-    // The area's bottom and top rows, counted from the image's bottom.
-    let j_bottom = settings.height - (area.y + area.height);
-    let j_top = j_bottom + area.height.max(1) - 1;
+    // The area's bottom row, counted from the image's bottom.
+    let j0 = settings.height - (area.y + area.height);
     let progress = aw as u64 * samples;
     for_each_band(
         settings,
@@ -115,14 +74,39 @@ where
         aw * per_pixel,
         progress,
         control,
-        |r, states, counts| {
-            let j = if from_top {
-                j_top - r as u32
-            } else {
-                j_bottom + r as u32
-            };
-            row(j, states, counts)
-        },
+        |r, states, counts| row(j0 + r as u32, states, counts),
+    )
+}
+
+/// Runs `row(j, bytes, counts)` for every row of `area` (`j` from the bottom of the
+/// image) with its 3 bytes a pixel; `bytes` holds the area's rows TOP row first, the
+/// order of files and screens. Progress counts one sample a pixel.
+pub(super) fn for_each_row_of_bytes<F>(
+    settings: &Settings,
+    area: Region,
+    bytes: &mut [u8],
+    control: &RenderControl,
+    row: F,
+) -> Result<RayCounts, RenderError>
+where
+    F: Fn(u32, &mut [u8], &mut RayCounts) + Sync,
+{
+    let aw = area.width as usize;
+    assert_eq!(
+        bytes.len(),
+        3 * aw * area.height as usize,
+        "bytes must cover the area"
+    );
+    // The area's top row, counted from the image's bottom (saturating: an empty area
+    // at the bottom has none).
+    let j_top = settings.height.saturating_sub(area.y + 1);
+    for_each_band(
+        settings,
+        bytes,
+        3 * aw,
+        aw as u64,
+        control,
+        |r, bytes, counts| row(j_top - r as u32, bytes, counts),
     )
 }
 

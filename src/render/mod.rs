@@ -28,7 +28,7 @@ use crate::trace::fast::FastTracer;
 use crate::trace::reference::ReferenceTracer;
 use crate::trace::{RayCounts, SampleTracer};
 use adaptive::adaptive;
-use bands::{for_each_pixel, for_each_row, for_each_row_from_top, in_pool, BAND_ROWS};
+use bands::{for_each_pixel, for_each_row, for_each_row_of_bytes, in_pool, BAND_ROWS};
 use film::{centre_height, film, pixel_centres};
 
 pub use adaptive::first_pass_samples;
@@ -243,20 +243,12 @@ fn one_sample_rgb8<T: SampleTracer>(
     control.set_samples_total(n as u64);
     let mut bytes = vec![0u8; 3 * n];
     let centres = pixel_centres(settings, area);
-    let rays = for_each_row_from_top(
-        settings,
-        area,
-        &mut bytes,
-        3,
-        1,
-        control,
-        |j, out, counts| {
-            let mut row = vec![Vec3::ZERO; centres.len()];
-            tracer.sample_row(&centres, centre_height(settings, j), &mut row, counts);
-            mend_non_finite(&mut row);
-            bytes_of_row(&row, out, byte);
-        },
-    )?;
+    let rays = for_each_row_of_bytes(settings, area, &mut bytes, control, |j, out, counts| {
+        let mut row = vec![Vec3::ZERO; centres.len()];
+        tracer.sample_row(&centres, centre_height(settings, j), &mut row, counts);
+        mend_non_finite(&mut row);
+        bytes_of_row(&row, out, byte);
+    })?;
     Ok((bytes, rays))
 }
 
