@@ -170,7 +170,22 @@ fn adaptive_region_is_the_crop_of_the_whole_image() {
             width: 30,
             height: 16,
         },
-    ] {
+    ]
+    .into_iter()
+    // Every column alone and every row alone: each pixel's neighbours left and right,
+    // then above and below, lie outside its region, and still flag it as in the whole.
+    .chain((0..64).map(|x| Region {
+        x,
+        y: 0,
+        width: 1,
+        height: 36,
+    }))
+    .chain((0..36).map(|y| Region {
+        x: 0,
+        y,
+        width: 64,
+        height: 1,
+    })) {
         opts.region = Some(region);
         let (part, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
         for y in 0..region.height {
@@ -241,6 +256,36 @@ fn first_pass_samples_spread_over_the_pixel() {
         }
     }
     assert_eq!(first_pass_samples(3, 4, 0), vec![0, 1, 2]);
+}
+
+#[test]
+fn first_pass_samples_take_one_sample_in_each_block_of_the_target_grid() {
+    // spp = n² samples in an n×n grid of strata, `first` = g² targets at the centres
+    // of a g×g grid of blocks, n/g odd: a target is the centre of its block's middle
+    // stratum, whose sample lies within √2/2n of it, and every sample outside the
+    // block at least 1/2g > √2/2n away; so the sample nearest each target lies in its
+    // block. Other pixels turn pixel (0, 0)'s strata by one rotation of their row-major
+    // order, which keeps one sample in each block.
+    for (spp, first) in [(36u32, 4u32), (81, 9), (100, 4), (144, 16)] {
+        let g = (first as f32).sqrt() as u32;
+        let ks = first_pass_samples(spp, first, 7);
+        for (i, j) in [(0, 0), (3, 4), (17, 5)] {
+            let mut blocks: Vec<(u32, u32)> = ks
+                .iter()
+                .map(|&k| {
+                    let (x, y) = sample_offset(i, j, k, spp, 7);
+                    ((x * g as f32) as u32, (y * g as f32) as u32)
+                })
+                .collect();
+            blocks.sort();
+            blocks.dedup();
+            assert_eq!(
+                blocks.len(),
+                first as usize,
+                "spp {spp}, pixel {i},{j}: {ks:?}"
+            );
+        }
+    }
 }
 
 #[test]
