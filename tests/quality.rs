@@ -187,7 +187,19 @@ fn adaptive_region_is_the_crop_of_the_whole_image() {
         height: 1,
     })) {
         opts.region = Some(region);
-        let (part, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
+        let control = RenderControl::default();
+        let rendered = render_bounded(&scene, &opts, &control).unwrap();
+        let part = rendered.frame;
+        // Rays from the eye: 4 first samples in each pixel of the region and of a
+        // one-pixel margin around it inside the image, then 12 more in each refined
+        // pixel; the progress counts them all and its total ends exact.
+        let (x0, y0) = (region.x.saturating_sub(1), region.y.saturating_sub(1));
+        let x1 = (region.x + region.width + 1).min(64);
+        let y1 = (region.y + region.height + 1).min(36);
+        let samples = u64::from((x1 - x0) * (y1 - y0)) * 4 + rendered.refined * 12;
+        assert_eq!(rendered.stats.rays.primary, samples, "region {region:?}");
+        assert_eq!(control.pixels_done(), samples, "region {region:?}");
+        assert_eq!(control.samples_total(), samples, "region {region:?}");
         for y in 0..region.height {
             for x in 0..region.width {
                 // Frames count rows from the bottom; regions from the top.
@@ -234,6 +246,73 @@ fn adaptive_refines_edges_not_flat_sky_and_stays_close_to_full_aa() {
     sky.spheres.clear();
     let b = render_bounded(&sky, &opts, &RenderControl::default()).unwrap();
     assert_eq!(b.refined, 0);
+}
+
+#[test]
+fn adaptive_refines_the_pixels_its_rule_names_and_gives_their_means() {
+    // The rule, from the f64 reference tracer's colours at the first samples' film
+    // positions (SPEC §2: s = (i + sx)/W, t = (j + sy)/H): a pixel takes all its
+    // samples when its first samples, clamped as shown, spread by the threshold or
+    // more in a channel, or its first samples' clamped mean differs by that much from
+    // a 4-neighbour's; otherwise it is the mean of its first samples.
+    let (w, h, spp, threshold) = (32u32, 18u32, 16u32, 0.05);
+    let (scene, mut opts) = hw3_opts(w, h, spp);
+    opts.quality.cutoff = 0.0;
+    opts.quality.adaptive = Some(Adaptive::with_threshold(threshold as f32));
+    let camera = support::spec_reference::spec_camera(&scene, w, h);
+    let tracer =
+        whitted::trace::reference::ReferenceTracer::new(&scene, camera, opts.quality.max_depth);
+    let first = first_pass_samples(spp, Adaptive::FIRST, opts.seed);
+    let colour = |i: u32, j: u32, k: u32| {
+        let (sx, sy) = sample_offset(i, j, k, spp, opts.seed);
+        let s = (f64::from(i) + f64::from(sx)) / f64::from(w);
+        let t = (f64::from(j) + f64::from(sy)) / f64::from(h);
+        let c = tracer.sample_f64(s, t, &mut Default::default());
+        assert!(c.is_finite());
+        c
+    };
+    let shown = |c: DVec3| c.clamp(DVec3::ZERO, DVec3::ONE);
+    let firsts: Vec<Vec<DVec3>> = (0..h)
+        .flat_map(|j| (0..w).map(move |i| (i, j)))
+        .map(|(i, j)| first.iter().map(|&k| colour(i, j, k)).collect())
+        .collect();
+    let mean = |p: &[DVec3]| p.iter().sum::<DVec3>() / p.len() as f64;
+    let at = |i: u32, j: u32| &firsts[(j * w + i) as usize];
+    let mut refined = 0;
+    let mut far = 0;
+    let a = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    for j in 0..h {
+        for i in 0..w {
+            let p = at(i, j);
+            let lo = p.iter().fold(DVec3::ONE, |m, &c| m.min(shown(c)));
+            let hi = p.iter().fold(DVec3::ZERO, |m, &c| m.max(shown(c)));
+            let m = shown(mean(p));
+            let neighbours = [(-1, 0), (1, 0), (0, -1), (0, 1)]
+                .into_iter()
+                .map(|(di, dj)| (i as i64 + di, j as i64 + dj))
+                .filter(|&(x, y)| (0..w as i64).contains(&x) && (0..h as i64).contains(&y));
+            let refine = (hi - lo).max_element() >= threshold
+                || neighbours.into_iter().any(|(x, y)| {
+                    (shown(mean(at(x as u32, y as u32))) - m)
+                        .abs()
+                        .max_element()
+                        >= threshold
+                });
+            let want = if refine {
+                refined += 1;
+                (0..spp).map(|k| colour(i, j, k)).sum::<DVec3>() / f64::from(spp)
+            } else {
+                mean(p)
+            };
+            let got = a.frame.get(i, j).as_dvec3();
+            if (got - want).abs().max_element() > 1e-4 {
+                far += 1;
+            }
+        }
+    }
+    assert!(refined > 0 && refined < w * h / 2, "refined {refined}");
+    assert_eq!(a.refined, u64::from(refined));
+    assert_eq!(far, 0, "pixels off the rule's values");
 }
 
 #[test]
