@@ -141,6 +141,48 @@ fn adaptive_with_threshold_zero_is_full_anti_aliasing_bit_for_bit() {
 }
 
 #[test]
+fn adaptive_pixels_carry_the_cutoff_bound_of_their_samples() {
+    // With the cutoff on, an adaptive pixel's value and bound are the means of its
+    // samples' colours and bounds. Threshold 0 refines every pixel: a full render of
+    // the same 9 samples. A threshold above any clamped difference refines none: each
+    // pixel has its 4 first samples, traced here at the SPEC's film positions
+    // (s = (i + sx)/W, t = (j + sy)/H).
+    let (scene, mut opts) = hw3_opts(24, 14, 9);
+    opts.quality.cutoff = 0.05;
+    let full = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    assert!(full.cutoff_bound.iter().any(|&b| b > 0.0));
+    opts.quality.adaptive = Some(Adaptive::with_threshold(0.0));
+    let a = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    assert_eq!(a.refined, 24 * 14);
+    assert_eq!(a.frame, full.frame);
+    assert_eq!(a.cutoff_bound, full.cutoff_bound);
+
+    opts.quality.spp = 16;
+    opts.quality.adaptive = Some(Adaptive::with_threshold(2.0));
+    let a = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    assert_eq!(a.refined, 0);
+    let tracer = make_tracer(&scene, &opts).unwrap();
+    let first = first_pass_samples(16, Adaptive::FIRST, opts.seed);
+    for j in 0..14 {
+        for i in 0..24 {
+            let (mut sum, mut bound) = (Vec3::ZERO, 0.0);
+            for &k in &first {
+                let (sx, sy) = sample_offset(i, j, k, 16, opts.seed);
+                let (s, t) = ((i as f32 + sx) / 24.0, (j as f32 + sy) / 14.0);
+                let (c, b) = tracer.sample_bounded(s, t, &mut Default::default());
+                sum += c;
+                bound += b;
+            }
+            let n = (j * 24 + i) as usize;
+            let (got, got_bound) = (a.frame.pixels[n], a.cutoff_bound[n]);
+            assert!((got - sum / 4.0).abs().max_element() < 1e-6, "{i},{j}");
+            assert!((got_bound - bound / 4.0).abs() <= 1e-6 * bound, "{i},{j}");
+        }
+    }
+    assert!(a.cutoff_bound.iter().any(|&b| b > 0.0));
+}
+
+#[test]
 fn adaptive_region_is_the_crop_of_the_whole_image() {
     let (scene, mut opts) = hw3_opts(64, 36, 16);
     opts.quality.adaptive = Some(Adaptive::with_threshold(0.05));
