@@ -40,6 +40,30 @@ fn srgb_bytes_follow_the_formula_at_hand_picked_values() {
 }
 
 #[test]
+fn linear_bytes_round_the_f32_products_halves_up() {
+    // c = 0x3b008081 (0.0019607844…): c·255 = 0.50000003 exactly, 0.5 in f32, byte 1;
+    // c = 0x3c20a0a1 (0.0098039219…): c·255 = 2.50000009, 2.5 in f32, byte 3.
+    // Rounding halves to even would give 0 and 2.
+    assert_eq!(to_byte(f32::from_bits(0x3b00_8081)), 1);
+    assert_eq!(to_byte(f32::from_bits(0x3c20_a0a1)), 3);
+    // Every half k + ½ (k = 0..254) and 16 f32 either side of it: the byte is std's
+    // `round` (halves away from zero) of the f32 product, and below ½, where each f32
+    // product that is a half comes from an exact product just above it, the rounding
+    // of the exact product (c·255 is exact in f64).
+    for k in 0..255u32 {
+        let near = ((k as f32 + 0.5) / 255.0).to_bits();
+        for bits in near - 16..=near + 16 {
+            let c = f32::from_bits(bits);
+            let want = (c * 255.0).round() as u8;
+            assert_eq!(to_byte(c), want, "c = {c:e} ({bits:#x})");
+            if c < 0.5 {
+                assert_eq!(want, (f64::from(c) * 255.0).round() as u8, "{c:e}");
+            }
+        }
+    }
+}
+
+#[test]
 fn the_srgb_table_gives_the_formula_s_byte_for_every_f32() {
     // The table is a step function like the formula: equal at every step, where the
     // formula's byte goes up (found by bisection on the f32 bit patterns), and never

@@ -141,6 +141,48 @@ fn adaptive_with_threshold_zero_is_full_anti_aliasing_bit_for_bit() {
 }
 
 #[test]
+fn adaptive_pixels_carry_the_cutoff_bound_of_their_samples() {
+    // With the cutoff on, an adaptive pixel's value and bound are the means of its
+    // samples' colours and bounds. Threshold 0 refines every pixel: a full render of
+    // the same 9 samples. A threshold above any clamped difference refines none: each
+    // pixel has its 4 first samples, traced here at the SPEC's film positions
+    // (s = (i + sx)/W, t = (j + sy)/H).
+    let (scene, mut opts) = hw3_opts(24, 14, 9);
+    opts.quality.cutoff = 0.05;
+    let full = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    assert!(full.cutoff_bound.iter().any(|&b| b > 0.0));
+    opts.quality.adaptive = Some(Adaptive::with_threshold(0.0));
+    let a = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    assert_eq!(a.refined, 24 * 14);
+    assert_eq!(a.frame, full.frame);
+    assert_eq!(a.cutoff_bound, full.cutoff_bound);
+
+    opts.quality.spp = 16;
+    opts.quality.adaptive = Some(Adaptive::with_threshold(2.0));
+    let a = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    assert_eq!(a.refined, 0);
+    let tracer = make_tracer(&scene, &opts).unwrap();
+    let first = first_pass_samples(16, Adaptive::FIRST, opts.seed);
+    for j in 0..14 {
+        for i in 0..24 {
+            let (mut sum, mut bound) = (Vec3::ZERO, 0.0);
+            for &k in &first {
+                let (sx, sy) = sample_offset(i, j, k, 16, opts.seed);
+                let (s, t) = ((i as f32 + sx) / 24.0, (j as f32 + sy) / 14.0);
+                let (c, b) = tracer.sample_bounded(s, t, &mut Default::default());
+                sum += c;
+                bound += b;
+            }
+            let n = (j * 24 + i) as usize;
+            let (got, got_bound) = (a.frame.pixels[n], a.cutoff_bound[n]);
+            assert!((got - sum / 4.0).abs().max_element() < 1e-6, "{i},{j}");
+            assert!((got_bound - bound / 4.0).abs() <= 1e-6 * bound, "{i},{j}");
+        }
+    }
+    assert!(a.cutoff_bound.iter().any(|&b| b > 0.0));
+}
+
+#[test]
 fn adaptive_region_is_the_crop_of_the_whole_image() {
     let (scene, mut opts) = hw3_opts(64, 36, 16);
     opts.quality.adaptive = Some(Adaptive::with_threshold(0.05));
@@ -170,9 +212,36 @@ fn adaptive_region_is_the_crop_of_the_whole_image() {
             width: 30,
             height: 16,
         },
-    ] {
+    ]
+    .into_iter()
+    // Every column alone and every row alone: each pixel's neighbours left and right,
+    // then above and below, lie outside its region, and still flag it as in the whole.
+    .chain((0..64).map(|x| Region {
+        x,
+        y: 0,
+        width: 1,
+        height: 36,
+    }))
+    .chain((0..36).map(|y| Region {
+        x: 0,
+        y,
+        width: 64,
+        height: 1,
+    })) {
         opts.region = Some(region);
-        let (part, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
+        let control = RenderControl::default();
+        let rendered = render_bounded(&scene, &opts, &control).unwrap();
+        let part = rendered.frame;
+        // Rays from the eye: 4 first samples in each pixel of the region and of a
+        // one-pixel margin around it inside the image, then 12 more in each refined
+        // pixel; the progress counts them all and its total ends exact.
+        let (x0, y0) = (region.x.saturating_sub(1), region.y.saturating_sub(1));
+        let x1 = (region.x + region.width + 1).min(64);
+        let y1 = (region.y + region.height + 1).min(36);
+        let samples = u64::from((x1 - x0) * (y1 - y0)) * 4 + rendered.refined * 12;
+        assert_eq!(rendered.stats.rays.primary, samples, "region {region:?}");
+        assert_eq!(control.pixels_done(), samples, "region {region:?}");
+        assert_eq!(control.samples_total(), samples, "region {region:?}");
         for y in 0..region.height {
             for x in 0..region.width {
                 // Frames count rows from the bottom; regions from the top.
@@ -222,6 +291,73 @@ fn adaptive_refines_edges_not_flat_sky_and_stays_close_to_full_aa() {
 }
 
 #[test]
+fn adaptive_refines_the_pixels_its_rule_names_and_gives_their_means() {
+    // The rule, from the f64 reference tracer's colours at the first samples' film
+    // positions (SPEC §2: s = (i + sx)/W, t = (j + sy)/H): a pixel takes all its
+    // samples when its first samples, clamped as shown, spread by the threshold or
+    // more in a channel, or its first samples' clamped mean differs by that much from
+    // a 4-neighbour's; otherwise it is the mean of its first samples.
+    let (w, h, spp, threshold) = (32u32, 18u32, 16u32, 0.05);
+    let (scene, mut opts) = hw3_opts(w, h, spp);
+    opts.quality.cutoff = 0.0;
+    opts.quality.adaptive = Some(Adaptive::with_threshold(threshold as f32));
+    let camera = support::spec_reference::spec_camera(&scene, w, h);
+    let tracer =
+        whitted::trace::reference::ReferenceTracer::new(&scene, camera, opts.quality.max_depth);
+    let first = first_pass_samples(spp, Adaptive::FIRST, opts.seed);
+    let colour = |i: u32, j: u32, k: u32| {
+        let (sx, sy) = sample_offset(i, j, k, spp, opts.seed);
+        let s = (f64::from(i) + f64::from(sx)) / f64::from(w);
+        let t = (f64::from(j) + f64::from(sy)) / f64::from(h);
+        let c = tracer.sample_f64(s, t, &mut Default::default());
+        assert!(c.is_finite());
+        c
+    };
+    let shown = |c: DVec3| c.clamp(DVec3::ZERO, DVec3::ONE);
+    let firsts: Vec<Vec<DVec3>> = (0..h)
+        .flat_map(|j| (0..w).map(move |i| (i, j)))
+        .map(|(i, j)| first.iter().map(|&k| colour(i, j, k)).collect())
+        .collect();
+    let mean = |p: &[DVec3]| p.iter().sum::<DVec3>() / p.len() as f64;
+    let at = |i: u32, j: u32| &firsts[(j * w + i) as usize];
+    let mut refined = 0;
+    let mut far = 0;
+    let a = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+    for j in 0..h {
+        for i in 0..w {
+            let p = at(i, j);
+            let lo = p.iter().fold(DVec3::ONE, |m, &c| m.min(shown(c)));
+            let hi = p.iter().fold(DVec3::ZERO, |m, &c| m.max(shown(c)));
+            let m = shown(mean(p));
+            let neighbours = [(-1, 0), (1, 0), (0, -1), (0, 1)]
+                .into_iter()
+                .map(|(di, dj)| (i as i64 + di, j as i64 + dj))
+                .filter(|&(x, y)| (0..w as i64).contains(&x) && (0..h as i64).contains(&y));
+            let refine = (hi - lo).max_element() >= threshold
+                || neighbours.into_iter().any(|(x, y)| {
+                    (shown(mean(at(x as u32, y as u32))) - m)
+                        .abs()
+                        .max_element()
+                        >= threshold
+                });
+            let want = if refine {
+                refined += 1;
+                (0..spp).map(|k| colour(i, j, k)).sum::<DVec3>() / f64::from(spp)
+            } else {
+                mean(p)
+            };
+            let got = a.frame.get(i, j).as_dvec3();
+            if (got - want).abs().max_element() > 1e-4 {
+                far += 1;
+            }
+        }
+    }
+    assert!(refined > 0 && refined < w * h / 2, "refined {refined}");
+    assert_eq!(a.refined, u64::from(refined));
+    assert_eq!(far, 0, "pixels off the rule's values");
+}
+
+#[test]
 fn first_pass_samples_spread_over_the_pixel() {
     for (spp, first) in [(16, 4), (64, 4), (9, 4), (5, 4), (32, 9), (16, 1)] {
         let ks = first_pass_samples(spp, first, 7);
@@ -241,6 +377,36 @@ fn first_pass_samples_spread_over_the_pixel() {
         }
     }
     assert_eq!(first_pass_samples(3, 4, 0), vec![0, 1, 2]);
+}
+
+#[test]
+fn first_pass_samples_take_one_sample_in_each_block_of_the_target_grid() {
+    // spp = n² samples in an n×n grid of strata, `first` = g² targets at the centres
+    // of a g×g grid of blocks, n/g odd: a target is the centre of its block's middle
+    // stratum, whose sample lies within √2/2n of it, and every sample outside the
+    // block at least 1/2g > √2/2n away; so the sample nearest each target lies in its
+    // block. Other pixels turn pixel (0, 0)'s strata by one rotation of their row-major
+    // order, which keeps one sample in each block.
+    for (spp, first) in [(36u32, 4u32), (81, 9), (100, 4), (144, 16)] {
+        let g = (first as f32).sqrt() as u32;
+        let ks = first_pass_samples(spp, first, 7);
+        for (i, j) in [(0, 0), (3, 4), (17, 5)] {
+            let mut blocks: Vec<(u32, u32)> = ks
+                .iter()
+                .map(|&k| {
+                    let (x, y) = sample_offset(i, j, k, spp, 7);
+                    ((x * g as f32) as u32, (y * g as f32) as u32)
+                })
+                .collect();
+            blocks.sort();
+            blocks.dedup();
+            assert_eq!(
+                blocks.len(),
+                first as usize,
+                "spp {spp}, pixel {i},{j}: {ks:?}"
+            );
+        }
+    }
 }
 
 #[test]

@@ -345,6 +345,24 @@ mod tests {
     }
 
     #[test]
+    fn the_estimate_is_exact_once_every_row_is_flagged() {
+        // When the first pass has flagged every row of the whole image, the estimate
+        // counts every pixel it refines: the last total it sets is the final one.
+        let totals = Mutex::new(Vec::new());
+        watch_progress(|tracer, settings, a, control| {
+            adaptive(tracer, settings, a, control, &|t| {
+                totals.lock().unwrap().push(t);
+                control.set_samples_total(t)
+            })
+            .unwrap()
+        });
+        let totals = totals.into_inner().unwrap();
+        let n = totals.len();
+        assert!(n > 100, "{n} totals set");
+        assert_eq!(totals[n - 2], totals[n - 1]);
+    }
+
+    #[test]
     fn progress_in_strips_settles_early_too() {
         // Strips of 23 rows: 8 of them. Strips differ in cost (sky above, balls below),
         // and those to come are estimated from those done: looser than one strip's
