@@ -86,6 +86,30 @@ fn fast_matches_reference_with_two_and_three_coloured_lights() {
     );
 }
 
+/// Materials that mix: the small balls made partly diffuse and partly mirror, glass, or
+/// both (weights between 0 and 1, two indices of refraction), so that every weight of
+/// SPEC §2's mix (`(1 − w_t)(1 − w_r)` local, `w_r` reflected, `w_t` transmitted) is
+/// neither 0 nor 1 somewhere.
+#[test]
+fn fast_matches_reference_with_mixed_materials() {
+    let mut scene = hw3_lit(&TWO_LIGHTS);
+    for (i, ball) in scene.spheres.iter_mut().skip(4).enumerate() {
+        (ball.reflect, ball.transmit, ball.ior) = match i % 4 {
+            0 => (0.35, 0.0, 1.5),
+            1 => (0.0, 0.45, 1.5),
+            2 => (0.25, 0.3, 1.33),
+            _ => (0.6, 0.2, 2.0),
+        };
+    }
+    compare(
+        "hw3, mixed materials, 320x180, 1 spp",
+        &scene,
+        (320, 180),
+        1,
+        None,
+    );
+}
+
 /// Anti-aliased: the samples' film positions matter (`t` divides by the height). Also
 /// at 2:1, where the scene's camera is the look-at form, and with 3 samples (a 2×2
 /// grid with one cell left out).

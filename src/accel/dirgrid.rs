@@ -284,11 +284,13 @@ impl CellCones {
     fn meets(&self, face: u32, u: u32, v: u32, sphere: &SphereCone) -> bool {
         let (axis, cos_cell, sin_cell) = self.cones[(v * self.n + u) as usize];
         let axis = from_face(face, axis);
-        // The angle between the axes must not exceed the sum of the half-angles.
+        // The angle between the axes must not exceed the sum of the half-angles. Both
+        // are below 90° (a cell spans less than a face; a sphere around the centre is
+        // in every cell and never gets here), so the sum is below 180° and its cosine
+        // orders angles.
         let cos_between = sphere.axis.dot(axis);
         let cos_sum = cos_cell * sphere.cos - sin_cell * sphere.sin;
-        let sum_exceeds_pi = sin_cell * sphere.cos + cos_cell * sphere.sin < 0.0;
-        sum_exceeds_pi || cos_between >= cos_sum - 1e-9
+        cos_between >= cos_sum - 1e-9
     }
 }
 

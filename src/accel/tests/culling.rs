@@ -538,9 +538,11 @@ fn rays_inside_a_sphere_meet_what_brute_force_meets() {
 }
 
 /// The finest grids (an eye grid for more than 16,384 spheres, the lights' 256-cell
-/// grids): the peers' scene of 20,000 balls on the ground, seen from its camera. Every
-/// primary ray's sphere, and the shadow factor from its hit, equal brute force in
-/// `f64` (ambiguous cases left out and counted, as above).
+/// grids) and a hierarchy whose big subtrees are built on threads of their own: the
+/// peers' scene of 20,000 balls on the ground, seen from its camera. Every primary
+/// ray's sphere, the shadow factor from its hit, and the sphere a ray from a point
+/// among the balls meets through the hierarchy, equal brute force in `f64`
+/// (ambiguous cases left out and counted, as above).
 #[test]
 fn large_scenes_lose_no_hit_or_occluder() {
     let scene = crate::scene::many_scene(20_000);
@@ -559,6 +561,7 @@ fn large_scenes_lose_no_hit_or_occluder() {
     };
     let (mut tested, mut ambiguous, mut shadows) = (0u32, 0u32, 0u32);
     let (mut balls, mut shadowed) = (0u32, 0u32);
+    let (mut walks, mut walks_on_balls) = (0u32, 0u32);
     for _ in 0..3000 {
         let s = &spheres[((next() * spheres.len() as f64) as usize).min(spheres.len() - 1)];
         let u = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
@@ -581,6 +584,25 @@ fn large_scenes_lose_no_hit_or_occluder() {
         let want = sorted.first().map(|x| x.0 as u32);
         let got = set.closest_from_eye(&eye_grid, q.dir);
         assert_eq!(got.map(|h| h.sphere), want, "ray {q:?}");
+        // The same aim from a point among the balls, through the hierarchy.
+        let from = DVec3::new(next() - 0.5, 0.1 * next(), next() - 0.5) * 40.0;
+        let walked = Query {
+            origin: from,
+            dir: (aim - from).normalize().as_vec3().normalize(),
+            from: None,
+        };
+        let (wo, wd) = query_ray(&walked);
+        let all = crossings(wo, wd, spheres, None, 0.0);
+        let mut sorted: Vec<_> = all.iter().filter(|x| !x.1.is_nan()).collect();
+        sorted.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let tie = sorted.len() >= 2 && (sorted[1].1 - sorted[0].1) <= 1e-9 * sorted[1].1.abs();
+        if !(all.iter().any(|x| x.3) || tie) {
+            walks += 1;
+            let want = sorted.first().map(|x| x.0 as u32);
+            walks_on_balls += u32::from(want.is_some_and(|k| k >= 4));
+            let got = set.closest(&walked).map(|h| h.sphere);
+            assert_eq!(got, want, "walk {walked:?}");
+        }
         let Some(hit) = got else { continue };
         balls += u32::from(hit.sphere >= 4); // not the ground nor the three big balls
         let (sq, dist, want) = shadow_case(spheres, &hit, light);
@@ -595,7 +617,12 @@ fn large_scenes_lose_no_hit_or_occluder() {
     }
     println!(
         "large scene: {tested} primary rays tested ({ambiguous} ambiguous, {balls} on small \
-         balls), {shadows} shadow rays ({shadowed} shadowed)"
+         balls), {shadows} shadow rays ({shadowed} shadowed), {walks} walks \
+         ({walks_on_balls} on small balls)"
+    );
+    assert!(
+        walks > 2500 && walks_on_balls > 1000,
+        "{walks} {walks_on_balls}"
     );
     assert!(tested > 2500 && balls > 1000, "{tested} {balls}");
     assert!(shadows > 1500 && shadowed > 100, "{shadows} {shadowed}");
