@@ -537,6 +537,18 @@ fn rays_inside_a_sphere_meet_what_brute_force_meets() {
     );
 }
 
+/// The sphere query `q` meets first (`Some(None)`: none, the sky), by brute force
+/// in `f64`; `None` when that is too close to call (a tangent crossing, or two nearest
+/// crossings within 10⁻⁹ of each other).
+fn nearest_sphere(q: &Query, spheres: &[Sphere]) -> Option<Option<u32>> {
+    let (o, d) = query_ray(q);
+    let all = crossings(o, d, spheres, None, 0.0);
+    let mut sorted: Vec<_> = all.iter().filter(|x| !x.1.is_nan()).collect();
+    sorted.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let tie = sorted.len() >= 2 && (sorted[1].1 - sorted[0].1) <= 1e-9 * sorted[1].1.abs();
+    (!(all.iter().any(|x| x.3) || tie)).then(|| sorted.first().map(|x| x.0 as u32))
+}
+
 /// The finest grids (an eye grid for more than 16,384 spheres, the lights' 256-cell
 /// grids) and a hierarchy whose big subtrees are built on threads of their own: the
 /// peers' scene of 20,000 balls on the ground, seen from its camera. Every primary
@@ -571,17 +583,11 @@ fn large_scenes_lose_no_hit_or_occluder() {
             dir: (aim - eye).normalize().as_vec3().normalize(),
             from: None,
         };
-        let (o, d) = query_ray(&q);
-        let all = crossings(o, d, spheres, None, 0.0);
-        let mut sorted: Vec<_> = all.iter().filter(|x| !x.1.is_nan()).collect();
-        sorted.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let tie = sorted.len() >= 2 && (sorted[1].1 - sorted[0].1) <= 1e-9 * sorted[1].1.abs();
-        if all.iter().any(|x| x.3) || tie {
+        let Some(want) = nearest_sphere(&q, spheres) else {
             ambiguous += 1;
             continue;
-        }
+        };
         tested += 1;
-        let want = sorted.first().map(|x| x.0 as u32);
         let got = set.closest_from_eye(&eye_grid, q.dir);
         assert_eq!(got.map(|h| h.sphere), want, "ray {q:?}");
         // The same aim from a point among the balls, through the hierarchy.
@@ -591,14 +597,8 @@ fn large_scenes_lose_no_hit_or_occluder() {
             dir: (aim - from).normalize().as_vec3().normalize(),
             from: None,
         };
-        let (wo, wd) = query_ray(&walked);
-        let all = crossings(wo, wd, spheres, None, 0.0);
-        let mut sorted: Vec<_> = all.iter().filter(|x| !x.1.is_nan()).collect();
-        sorted.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let tie = sorted.len() >= 2 && (sorted[1].1 - sorted[0].1) <= 1e-9 * sorted[1].1.abs();
-        if !(all.iter().any(|x| x.3) || tie) {
+        if let Some(want) = nearest_sphere(&walked, spheres) {
             walks += 1;
-            let want = sorted.first().map(|x| x.0 as u32);
             walks_on_balls += u32::from(want.is_some_and(|k| k >= 4));
             let got = set.closest(&walked).map(|h| h.sphere);
             assert_eq!(got, want, "walk {walked:?}");
