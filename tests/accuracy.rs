@@ -110,6 +110,30 @@ fn fast_matches_reference_with_mixed_materials() {
     );
 }
 
+/// A light a hair above the orange ball's top, 1.5·10⁻⁶ of its radius away: outside
+/// the band of spheres the light's grid tests for every segment (10⁻⁶), inside the one
+/// where the quick test's widened sphere reaches over the light (its slack, 2⁻¹⁸ of
+/// the squared distances). The ball shades the whole ground, each point by how steeply
+/// its segment enters the ball just below the light; a quick test that loses the ball
+/// lights the ground.
+#[test]
+fn fast_matches_reference_with_a_light_a_hair_above_a_ball() {
+    let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+    let ball = &scene.spheres[3];
+    let top = ball.center + DVec3::Y * ball.radius * (1.0 + 1.5e-6);
+    scene.lights = vec![Light {
+        position: top,
+        intensity: DVec3::ONE,
+    }];
+    compare(
+        "hw3, a light 1.5e-6 r above the orange ball, 320x180, 1 spp",
+        &scene,
+        (320, 180),
+        1,
+        None,
+    );
+}
+
 /// Anti-aliased: the samples' film positions matter (`t` divides by the height). Also
 /// at 2:1, where the scene's camera is the look-at form, and with 3 samples (a 2×2
 /// grid with one cell left out).

@@ -347,9 +347,17 @@ mod tests {
     #[test]
     fn the_estimate_is_exact_once_every_row_is_flagged() {
         // When the first pass has flagged every row of the whole image, the estimate
-        // counts every pixel it refines: the last total it sets is the final one.
+        // counts every pixel it refines: the last total it sets is the final one. Every
+        // estimate lies between no pixel refined and every pixel refined.
         let totals = Mutex::new(Vec::new());
+        let mut bounds = (0, 0);
         watch_progress(|tracer, settings, a, control| {
+            let pixels = u64::from(settings.width) * u64::from(settings.height);
+            let first = pixels * u64::from(a.first);
+            bounds = (
+                first,
+                first + pixels * u64::from(settings.quality.spp - a.first),
+            );
             adaptive(tracer, settings, a, control, &|t| {
                 totals.lock().unwrap().push(t);
                 control.set_samples_total(t)
@@ -360,6 +368,13 @@ mod tests {
         let n = totals.len();
         assert!(n > 100, "{n} totals set");
         assert_eq!(totals[n - 2], totals[n - 1]);
+        let (least, most) = bounds;
+        for (k, &t) in totals.iter().enumerate() {
+            assert!(
+                (least..=most).contains(&t),
+                "total {k} of {n} is {t}, outside {least}..={most}"
+            );
+        }
     }
 
     #[test]
