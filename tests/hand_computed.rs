@@ -9,6 +9,7 @@ use whitted::intersect;
 use whitted::model;
 use whitted::render::{self, Frame, RenderControl};
 use whitted::settings::Precision;
+use whitted::trace::RayCounts;
 use whitted::Scene;
 
 // ---------------------------------------------------------------------------------
@@ -784,6 +785,44 @@ height = 1
         let t = 0.5 * (y + 1.0);
         let expected = DVec3::new(0.2, 0.4, 0.6) * (1.0 - t) + DVec3::new(1.0, 0.0, 0.5) * t;
         assert_pixel(&render_both(&custom), 0, 0, expected);
+    }
+}
+
+/// Rays counted by hand, kind by kind and in all, summed over the bands of rows. A
+/// half-mirror ball fills the 90° view (its angular radius, asin(2.5/3) = 56.4°, beyond
+/// the film corners' 54.7°), lit from behind the camera: each of the 4×24 pixels (three
+/// bands of 8 rows) casts one primary ray, whose hit faces the light (the visible cap's
+/// normals have n_z ≥ 0.83) and casts one shadow ray and one reflected ray, which leaves
+/// the convex ball for the sky.
+#[test]
+fn rays_are_counted_by_kind_and_in_all() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 4
+height = 24
+
+[[light]]
+position = [0, 0, 10]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 2.5
+reflect = 0.5
+"
+    );
+    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    for precision in [Precision::Fast, Precision::Reference] {
+        let mut opts = scene.settings();
+        opts.quality.precision = precision;
+        let (_, stats) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+        let expected = RayCounts {
+            primary: 96,
+            secondary: 96,
+            shadow: 96,
+        };
+        assert_eq!(stats.rays, expected, "{precision:?}");
+        assert_eq!(stats.rays.total(), 288, "{precision:?}");
     }
 }
 
