@@ -122,8 +122,15 @@ fn cutoff_skips_work_and_reports_a_nonzero_bound_on_hw3() {
 
 #[test]
 fn adaptive_with_threshold_zero_is_full_anti_aliasing_bit_for_bit() {
-    for spp in [5, 9, 16] {
+    // Both tracers: the reference one takes its bounded samples from the trait's default.
+    for (precision, spp) in [
+        (Precision::Fast, 5),
+        (Precision::Fast, 9),
+        (Precision::Fast, 16),
+        (Precision::Reference, 5),
+    ] {
         let (scene, mut opts) = hw3_opts(48, 27, spp);
+        opts.quality.precision = precision;
         let (full, _) = render(&scene, &opts, &RenderControl::default()).unwrap();
         // The viewer's path: passes of accumulate, then resolve.
         let tracer = make_tracer(&scene, &opts).unwrap();
@@ -131,12 +138,17 @@ fn adaptive_with_threshold_zero_is_full_anti_aliasing_bit_for_bit() {
         let control = RenderControl::default();
         accumulate(tracer.as_ref(), &opts, 0..2, &mut sums, &control).unwrap();
         accumulate(tracer.as_ref(), &opts, 2..spp, &mut sums, &control).unwrap();
-        assert_eq!(resolve(&sums, spp, 48, 27), full, "accumulate, spp {spp}");
+        assert_eq!(
+            resolve(&sums, spp, 48, 27),
+            full,
+            "accumulate, {precision:?}, spp {spp}"
+        );
 
         opts.quality.adaptive = Some(Adaptive::with_threshold(0.0));
         let adaptive = render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
         assert_eq!(adaptive.refined, 48 * 27);
-        assert_eq!(adaptive.frame, full, "spp {spp}");
+        assert_eq!(adaptive.frame, full, "{precision:?}, spp {spp}");
+        assert!(adaptive.cutoff_bound.iter().all(|&b| b == 0.0));
     }
 }
 
