@@ -826,6 +826,52 @@ reflect = 0.5
     }
 }
 
+/// Rays counted by hand where most of the view is sky. A ball of radius 1 at distance 3
+/// is hit by the ray through film point (x, y) iff 9(x² + y²)/(x² + y² + 1) < 1, i.e.
+/// x² + y² < ⅛. Of the 8×8 pixel centres (x, y ∈ ±⅛, ±⅜, ±⅝, ±⅞) only the four
+/// middle ones (x² + y² = 1/32) pass; the next ones (5/32) miss: far from the
+/// silhouette. So 64 primary rays, 60 of them sky (whole rows of sky among them), and
+/// each of the 4 hits, facing every light, casts one shadow ray a light and, when the
+/// ball reflects, one reflected ray.
+#[test]
+fn rays_are_counted_by_hand_in_a_view_mostly_of_sky() {
+    let one_light = "[[light]]\nposition = [0, 0, 10]\n";
+    let two_lights = "[[light]]\nposition = [0, 0, 10]\n[[light]]\nposition = [0, 10, 10]\n";
+    for (lights, count, reflect) in [
+        (one_light, 1, 0.0),
+        (one_light, 1, 0.5),
+        (two_lights, 2, 0.0),
+        (two_lights, 2, 0.5),
+    ] {
+        let toml = format!(
+            "{CAMERA}
+[image]
+width = 8
+height = 8
+
+{lights}
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+reflect = {reflect}
+"
+        );
+        let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+        for precision in [Precision::Fast, Precision::Reference] {
+            let mut opts = scene.settings();
+            opts.quality.precision = precision;
+            let (_, stats) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+            let expected = RayCounts {
+                primary: 64,
+                secondary: if reflect > 0.0 { 4 } else { 0 },
+                shadow: 4 * count,
+            };
+            let case = format!("{count} light(s), w_r {reflect}, {precision:?}");
+            assert_eq!(stats.rays, expected, "{case}");
+        }
+    }
+}
+
 /// SPEC §2: a term of zero weight is not computed. One ball fills a 3×3 view, lit from
 /// behind the camera: with `(1 − w_t)(1 − w_r) = 0` (a perfect mirror, clear glass, or
 /// both weights high) no pixel casts a shadow ray; otherwise every pixel's hit does.
