@@ -788,6 +788,15 @@ height = 1
     }
 }
 
+/// The rays a whole render of the scene `toml` casts, by kind, with `precision`'s tracer.
+fn rays_cast(toml: &str, precision: Precision) -> RayCounts {
+    let scene = Scene::from_toml_str(toml, "test.toml").expect("a valid test scene");
+    let mut opts = scene.settings();
+    opts.quality.precision = precision;
+    let (_, stats) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+    stats.rays
+}
+
 /// Rays counted by hand, kind by kind and in all, summed over the bands of rows. A
 /// half-mirror ball fills the 90° view (its angular radius, asin(2.5/3) = 56.4°, beyond
 /// the film corners' 54.7°), lit from behind the camera: each of the 4×24 pixels (three
@@ -811,18 +820,15 @@ radius = 2.5
 reflect = 0.5
 "
     );
-    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
     for precision in [Precision::Fast, Precision::Reference] {
-        let mut opts = scene.settings();
-        opts.quality.precision = precision;
-        let (_, stats) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+        let rays = rays_cast(&toml, precision);
         let expected = RayCounts {
             primary: 96,
             secondary: 96,
             shadow: 96,
         };
-        assert_eq!(stats.rays, expected, "{precision:?}");
-        assert_eq!(stats.rays.total(), 288, "{precision:?}");
+        assert_eq!(rays, expected, "{precision:?}");
+        assert_eq!(rays.total(), 288, "{precision:?}");
     }
 }
 
@@ -831,7 +837,7 @@ reflect = 0.5
 /// x² + y² < ⅛. Of the 8×8 pixel centres (x, y ∈ ±⅛, ±⅜, ±⅝, ±⅞) only the four
 /// middle ones (x² + y² = 1/32) pass; the next ones (5/32) miss: far from the
 /// silhouette. So 64 primary rays, 60 of them sky (whole rows of sky among them), and
-/// each of the 4 hits, facing every light, casts one shadow ray a light and, when the
+/// each of the 4 hits, facing every light, casts one shadow ray per light and, when the
 /// ball reflects, one reflected ray.
 #[test]
 fn rays_are_counted_by_hand_in_a_view_mostly_of_sky() {
@@ -856,18 +862,15 @@ radius = 1
 reflect = {reflect}
 "
         );
-        let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
         for precision in [Precision::Fast, Precision::Reference] {
-            let mut opts = scene.settings();
-            opts.quality.precision = precision;
-            let (_, stats) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+            let rays = rays_cast(&toml, precision);
             let expected = RayCounts {
                 primary: 64,
                 secondary: if reflect > 0.0 { 4 } else { 0 },
                 shadow: 4 * count,
             };
             let case = format!("{count} light(s), w_r {reflect}, {precision:?}");
-            assert_eq!(stats.rays, expected, "{case}");
+            assert_eq!(rays, expected, "{case}");
         }
     }
 }
@@ -903,24 +906,21 @@ reflect = {reflect}
 transmit = {transmit}
 "
         );
-        let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
         for precision in [Precision::Fast, Precision::Reference] {
-            let mut opts = scene.settings();
-            opts.quality.precision = precision;
-            let (_, stats) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
+            let rays = rays_cast(&toml, precision);
             let case = format!("w_r {reflect}, w_t {transmit}, {precision:?}");
-            assert_eq!(stats.rays.primary, 9, "{case}");
+            assert_eq!(rays.primary, 9, "{case}");
             // Every primary ray hits the ball, whose front faces the light.
-            let shadow = stats.rays.shadow;
+            let shadow = rays.shadow;
             if local {
                 assert!(shadow >= 9, "{case}: {shadow} shadow rays");
             } else {
                 assert_eq!(shadow, 0, "{case}");
             }
             if reflect == 0.0 && transmit == 0.0 {
-                assert_eq!(stats.rays.secondary, 0, "{case}");
+                assert_eq!(rays.secondary, 0, "{case}");
             } else {
-                assert!(stats.rays.secondary >= 9, "{case}");
+                assert!(rays.secondary >= 9, "{case}");
             }
         }
     }
