@@ -832,13 +832,15 @@ reflect = 0.5
     }
 }
 
-/// Rays counted by hand where most of the view is sky. A ball of radius 1 at distance 3
-/// is hit by the ray through film point (x, y) iff 9(x² + y²)/(x² + y² + 1) < 1, i.e.
-/// x² + y² < ⅛. Of the 8×8 pixel centres (x, y ∈ ±⅛, ±⅜, ±⅝, ±⅞) only the four
-/// middle ones (x² + y² = 1/32) pass; the next ones (5/32) miss: far from the
-/// silhouette. So 64 primary rays, 60 of them sky (whole rows of sky among them), and
-/// each of the 4 hits, facing every light, casts one shadow ray per light and, when the
-/// ball reflects, one reflected ray.
+/// Rays counted by hand where most of the view is sky, in runs of pixels that fall in
+/// one empty cell of the eye grid (12 cells a face for one sphere: 16 of the 192 pixel
+/// columns a cell, two aligned runs of 8). A ball of radius 1 at distance 3 is hit by
+/// the ray through film point (x, y) iff 9(x² + y²)/(x² + y² + 1) < 1, i.e.
+/// x² + y² < ⅛. The 192×8 pixel centres have y ∈ ±⅛, ±⅜, ±⅝, ±⅞ and x = k/192 for odd
+/// |k| ≤ 191: only the rows y = ±⅛ reach the ball, where x² < 7/64 holds for |k| ≤ 63
+/// (x² = 0.1077 against 0.1094; |k| = 65 gives 0.1146): 2 × 64 = 128 hits, each
+/// facing every light. So 1,536 primary rays, 1,408 of them sky, and each hit casts
+/// one shadow ray per light and, when the ball reflects, one reflected ray.
 #[test]
 fn rays_are_counted_by_hand_in_a_view_mostly_of_sky() {
     let one_light = "[[light]]\nposition = [0, 0, 10]\n";
@@ -852,7 +854,7 @@ fn rays_are_counted_by_hand_in_a_view_mostly_of_sky() {
         let toml = format!(
             "{CAMERA}
 [image]
-width = 8
+width = 192
 height = 8
 
 {lights}
@@ -865,9 +867,9 @@ reflect = {reflect}
         for precision in [Precision::Fast, Precision::Reference] {
             let rays = rays_cast(&toml, precision);
             let expected = RayCounts {
-                primary: 64,
-                secondary: if reflect > 0.0 { 4 } else { 0 },
-                shadow: 4 * count,
+                primary: 1536,
+                secondary: if reflect > 0.0 { 128 } else { 0 },
+                shadow: 128 * count,
             };
             let case = format!("{count} light(s), w_r {reflect}, {precision:?}");
             assert_eq!(rays, expected, "{case}");
