@@ -3,7 +3,8 @@
 //! region, mean, bytes), not by the renderer's: at most 0.01% of the pixels may differ
 //! by more than one 8-bit level, and none by more than 8 except a handful on
 //! silhouettes. The built-in scene with one light, and with two and three coloured
-//! lights (one behind the balls), at one sample a pixel and more, whole and in a region.
+//! lights (one behind the balls), at one sample a pixel and more, whole and in a region,
+//! and inside a diffuse dome.
 
 mod support;
 
@@ -127,6 +128,26 @@ fn fast_matches_reference_with_a_light_a_hair_above_a_ball() {
     }];
     compare(
         "hw3, a light 1.5e-6 r above the orange ball, 320x180, 1 spp",
+        &scene,
+        (320, 180),
+        1,
+        None,
+    );
+}
+
+/// Inside a diffuse dome: hw3 under a white ball of radius 30 around the camera, which
+/// the ground cuts. Every ray that misses the balls and the ground meets the dome from
+/// inside, where the normal that faces the ray is the inward one (`nf = −n`) and the
+/// light, inside too, lights it.
+#[test]
+fn fast_matches_reference_inside_a_diffuse_dome() {
+    let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+    scene.spheres.push(whitted::scene::Sphere::new(
+        DVec3::new(0.0, 0.0, -2.0),
+        30.0,
+    ));
+    compare(
+        "hw3 inside a diffuse dome, 320x180, 1 spp",
         &scene,
         (320, 180),
         1,

@@ -927,3 +927,121 @@ transmit = {transmit}
         }
     }
 }
+
+/// The contribution cutoff ε by hand. A ball that is half mirror, half clear glass of
+/// index 1 (so rays cross it unbent) is seen head-on at p = (0, 0, −2), normal
+/// (0, 0, 1), lit from straight behind the camera: n·L = 1, nothing on the segment, so
+/// local = kd ⊙ I = (1, 0.5, 0.25). Its branches' path weights, all exact in binary:
+/// - at p (weight 1): local (1 − w_t)(1 − w_r) = ¼; reflected (1 − w_t)·w_r = ¼, back
+///   past the camera to the sky at d.y = 0, (0.75, 0.85, 1); transmitted w_t = ½, to
+///   the far side q = (0, 0, −4);
+/// - at q (weight ½): local ⅛; reflected ⅛, back inside the ball; transmitted ¼, out to
+///   the sky at d.y = 0.
+///
+/// A branch of weight below ε is not traced: its colour counts as 0 and its weight
+/// goes into the pixel's bound, times the largest value a trace returns (1 here: the
+/// sky's `down` and the light's intensity).
+/// - ε = ¼ keeps the branches of weight ¼ (below is strict) and skips q's local and
+///   reflected: colour ¼·local + ¼·sky + ½·(½·sky) = (0.625, 0.55, 0.5625), bound ¼;
+///   one primary ray, three secondary (p's reflected and transmitted, q's
+///   transmitted), one shadow ray (p's).
+/// - ε = 0.3 keeps only p's transmitted branch, whose three branches at q are all
+///   skipped: colour 0, bound ¼ + ¼ + ⅛ + ⅛ + ¼ = 1; one primary and one secondary ray.
+#[test]
+fn the_cutoff_skips_branches_below_it_by_hand() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 1
+height = 1
+
+[[light]]
+position = [0, 0, 10]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+color = [1.0, 0.5, 0.25]
+reflect = 0.5
+transmit = 0.5
+ior = 1
+"
+    );
+    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let sky = DVec3::new(0.75, 0.85, 1.0);
+    let local = DVec3::new(1.0, 0.5, 0.25);
+    for (cutoff, colour, bound, rays) in [
+        (
+            0.25,
+            local * 0.25 + sky * 0.5,
+            0.25,
+            RayCounts {
+                primary: 1,
+                secondary: 3,
+                shadow: 1,
+            },
+        ),
+        (
+            0.3,
+            DVec3::ZERO,
+            1.0,
+            RayCounts {
+                primary: 1,
+                secondary: 1,
+                shadow: 0,
+            },
+        ),
+    ] {
+        let mut opts = scene.settings();
+        opts.quality.cutoff = cutoff;
+        let cut = render::render_bounded(&scene, &opts, &RenderControl::default()).unwrap();
+        let got = cut.frame.get(0, 0).as_dvec3();
+        assert!(close(got, colour, 1e-6), "ε {cutoff}: {got} vs {colour}");
+        assert_eq!(cut.cutoff_bound, [bound], "ε {cutoff}");
+        assert_eq!(cut.stats.rays, rays, "ε {cutoff}");
+    }
+}
+
+/// A light in the plane tangent to the hit point (n·L = 0 exactly) adds nothing and
+/// casts no shadow ray (SPEC §2 step 4 takes `max(0, n·L)`; a factor of 0 is a term of
+/// zero weight). The diffuse ball at (0, 0, −3) is seen head-on at p = (0, 0, −2),
+/// n = (0, 0, 1); the light at (5, 0, −2) gives L = (1, 0, 0). Both tracers, one pixel
+/// at a time; and the fast tracer's row of two samples, which shades pairs of diffuse
+/// hits side by side.
+#[test]
+fn a_light_in_the_tangent_plane_casts_no_shadow_ray() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 1
+height = 1
+
+[[light]]
+position = [5, 0, -2]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+"
+    );
+    let one_ray = RayCounts {
+        primary: 1,
+        secondary: 0,
+        shadow: 0,
+    };
+    for precision in [Precision::Fast, Precision::Reference] {
+        assert_eq!(rays_cast(&toml, precision), one_ray, "{precision:?}");
+    }
+    assert_pixel(&render_both(&toml), 0, 0, DVec3::ZERO);
+
+    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let tracer = render::make_tracer(&scene, &scene.settings()).unwrap();
+    let (mut out, mut rays) = ([Vec3::ONE; 2], RayCounts::default());
+    tracer.sample_row(&[0.5, 0.5], 0.5, &mut out, &mut rays);
+    assert_eq!(out, [Vec3::ZERO; 2]);
+    let two_rays = RayCounts {
+        primary: 2,
+        ..one_ray
+    };
+    assert_eq!(rays, two_rays);
+}

@@ -120,6 +120,40 @@ fn cutoff_skips_work_and_reports_a_nonzero_bound_on_hw3() {
     assert_ne!(cut.frame, exact.frame);
 }
 
+/// `SampleTracer::sample_row` gives the colours `sample` gives one by one, and casts the
+/// same rays, whatever the cutoff: the fast tracer shares work along a row only where
+/// nothing is skipped. At ε = 1.5 every branch is skipped (a primary hit's weights are
+/// at most 1), so every pixel but the sky's is black.
+#[test]
+fn a_row_of_samples_is_its_samples_one_by_one_at_any_cutoff() {
+    let (scene, mut opts) = hw3_opts(96, 54, 1);
+    for cutoff in [0.0, 0.05, 0.25, 1.5] {
+        opts.quality.cutoff = cutoff;
+        let tracer = make_tracer(&scene, &opts).unwrap();
+        let s: Vec<f32> = (0..96).map(|i| (i as f32 + 0.5) / 96.0).collect();
+        let mut black = 0;
+        for j in 0..54 {
+            let t = (j as f32 + 0.5) / 54.0;
+            let (mut row, mut row_rays) = (vec![Vec3::NAN; 96], Default::default());
+            tracer.sample_row(&s, t, &mut row, &mut row_rays);
+            let mut one_by_one_rays = Default::default();
+            let one_by_one: Vec<Vec3> = s
+                .iter()
+                .map(|&s| tracer.sample(s, t, &mut one_by_one_rays))
+                .collect();
+            assert_eq!(row, one_by_one, "ε {cutoff}, row {j}");
+            assert_eq!(row_rays, one_by_one_rays, "ε {cutoff}, row {j}");
+            black += row.iter().filter(|c| **c == Vec3::ZERO).count();
+        }
+        // hw3's view is about half ground and balls.
+        assert_eq!(
+            black > 96 * 54 / 4,
+            cutoff > 1.0,
+            "ε {cutoff}: {black} black"
+        );
+    }
+}
+
 #[test]
 fn adaptive_with_threshold_zero_is_full_anti_aliasing_bit_for_bit() {
     // Both tracers: the reference one takes its bounded samples from the trait's default.
