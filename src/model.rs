@@ -167,7 +167,8 @@ pub fn combine<V: Vector>(w_r: V::R, w_t: V::R, local: V, reflected: V, transmit
 pub struct Branches {
     /// The local term (diffuse and shadows): `(1 − w_t)(1 − w_r) ≠ 0`.
     pub local: bool,
-    /// The reflected ray: `w_r ≠ 0`.
+    /// The reflected ray: `(1 − w_t)·w_r ≠ 0` (a clear surface, `w_t = 1`, reflects
+    /// nothing whatever its `w_r`).
     pub reflect: bool,
     /// The transmitted ray: `w_t ≠ 0`.
     pub transmit: bool,
@@ -183,7 +184,7 @@ impl Branches {
     pub fn of(w_r: f64, w_t: f64) -> Self {
         Branches {
             local: (1.0 - w_t) * (1.0 - w_r) != 0.0,
-            reflect: w_r != 0.0,
+            reflect: (1.0 - w_t) * w_r != 0.0,
             transmit: w_t != 0.0,
         }
     }
