@@ -1051,3 +1051,92 @@ radius = 1
     };
     assert_eq!(rays, two_rays);
 }
+
+/// SPEC §2 step 2 takes intersections in front of the origin: `t > 0`. A camera on a
+/// ball's surface (the ball at (0, 0, −1), radius 1, through the origin) has a root at
+/// `t = 0` exactly (`|o − c|² = r²`), which does not count: the ray looks down −z into
+/// the ball and meets its far side q = (0, 0, −2) from inside, where the normal that
+/// faces the ray is (0, 0, 1). The light at the ball's centre is then straight ahead
+/// (n·L = 1) and nothing lies between (the segment stops at the light, before the ball
+/// is left again): colour kd ⊙ I = (1, 0.5, 0.25). Counting the root at 0, the camera
+/// would see the ball's outside, facing away from the light: black.
+#[test]
+fn a_camera_on_a_ball_s_surface_sees_its_inside() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 1
+height = 1
+
+[[light]]
+position = [0, 0, -1]
+
+[[sphere]]
+center = [0, 0, -1]
+radius = 1
+color = [1.0, 0.5, 0.25]
+"
+    );
+    assert_pixel(&render_both(&toml), 0, 0, DVec3::new(1.0, 0.5, 0.25));
+}
+
+/// The shadow segment is open at the light's end: a ball that the light sits on does
+/// not shadow it. The diffuse ball at (0, 0, −3) is seen head-on at p = (0, 0, −2);
+/// the light at (0, 0, 2) lies on the surface of a ball at (0, 0, 3) behind the
+/// camera, which the segment p → P (length 4) meets exactly at its end, t = 4. So
+/// n·L = 1 and s = 1: colour kd ⊙ I. (Counted as an occluder it would give s = 0:
+/// its normal there, (0, 0, −1), faces the segment head-on.)
+#[test]
+fn a_ball_the_light_sits_on_casts_no_shadow_through_the_segment_s_end() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 1
+height = 1
+
+[[light]]
+position = [0, 0, 2]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+color = [1.0, 0.5, 0.25]
+
+[[sphere]]
+center = [0, 0, 3]
+radius = 1
+"
+    );
+    assert_pixel(&render_both(&toml), 0, 0, DVec3::new(1.0, 0.5, 0.25));
+}
+
+/// A hit at the world's origin is shadowed like any other. The camera at (0, 0, 1)
+/// sees the ball at (0, 0, −1) head-on at p = (0, 0, 0), normal (0, 0, 1); the light
+/// at (10, 0, 10) gives n·L = 1/√2, and the ball at (5, 0, 5) sits on the segment's
+/// line: the segment enters it head-on, L·n_k = −1, s = 0. Black. (A spawn tolerance
+/// that scales with 1/|p| would be infinite here and see no occluder.)
+#[test]
+fn a_hit_at_the_world_s_origin_is_shadowed() {
+    let toml = "[camera]
+origin = [0, 0, 1]
+lower_left = [-1, -1, 0]
+horizontal = [2, 0, 0]
+vertical = [0, 2, 0]
+
+[image]
+width = 1
+height = 1
+
+[[light]]
+position = [10, 0, 10]
+
+[[sphere]]
+center = [0, 0, -1]
+radius = 1
+
+[[sphere]]
+center = [5, 0, 5]
+radius = 1
+";
+    assert_pixel(&render_both(toml), 0, 0, DVec3::ZERO);
+}
