@@ -1245,3 +1245,54 @@ transmit = 1
     // returns the sky).
     assert_eq!(spawned, 1000 * 4);
 }
+
+/// The reference tracer's ray tree names the occluder that set the shadow factor: the
+/// one of least `(1 + L·n_k)/2`. The diffuse ball at (0, 0, −3) is seen head-on at
+/// p = (0, 0, −2) and lit from (0, 0, 10); the segment runs up the z axis behind the
+/// camera through two balls: the first listed, at (0.9, 0, 3), it crosses 0.9 off its
+/// centre, entering at (0, 0, 3 − √0.19) where n_k = (−0.9, 0, −√0.19), so its factor
+/// is (1 − √0.19)/2 = 0.282; the second, at (0, 0, 6), head-on: factor 0, s = 0.
+#[test]
+fn the_ray_tree_names_the_occluder_of_least_factor() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 1
+height = 1
+
+[[light]]
+position = [0, 0, 10]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+
+[[sphere]]
+center = [0.9, 0, 3]
+radius = 1
+
+[[sphere]]
+center = [0, 0, 6]
+radius = 1
+"
+    );
+    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let tracer =
+        whitted::trace::reference::ReferenceTracer::new(&scene, scene.camera(1, 1).unwrap(), 5);
+    let (colour, tree) = tracer.inspect(0.5, 0.5);
+    assert_eq!(colour, DVec3::ZERO);
+    let [shadow] = tree.shadows.as_slice() else {
+        panic!("one shadow ray: {:?}", tree.shadows);
+    };
+    assert_eq!((shadow.light, shadow.occluder), (0, Some(2)));
+    assert_eq!(shadow.factor, 0.0);
+    // Alone, the first ball sets the factor, and is named.
+    let mut scene = scene;
+    scene.spheres.pop();
+    let tracer =
+        whitted::trace::reference::ReferenceTracer::new(&scene, scene.camera(1, 1).unwrap(), 5);
+    let (_, tree) = tracer.inspect(0.5, 0.5);
+    assert_eq!(tree.shadows[0].occluder, Some(1));
+    let expected = (1.0 - 0.19f64.sqrt()) / 2.0;
+    assert!((tree.shadows[0].factor - expected).abs() < 1e-12);
+}
