@@ -1296,3 +1296,43 @@ radius = 1
     let expected = (1.0 - 0.19f64.sqrt()) / 2.0;
     assert!((tree.shadows[0].factor - expected).abs() < 1e-12);
 }
+
+/// The reference tracer's ray tree gives each term its weight in the pixel, the
+/// product of step 7's mixing weights along the path. A ball with `w_r = ¼`,
+/// `w_t = ½` and index 1, seen head-on and lit from behind the camera: at the front,
+/// local (1 − ½)(1 − ¼) = 3/8, reflected (1 − ½)·¼ = 1/8, transmitted ½; the
+/// transmitted ray meets the back from inside, faces the light again, and its terms
+/// weigh half as much: 3/16, 1/16, ¼.
+#[test]
+fn the_ray_tree_weighs_each_term_by_its_path() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 1
+height = 1
+
+[[light]]
+position = [0, 0, 10]
+
+[[sphere]]
+center = [0, 0, -3]
+radius = 1
+reflect = 0.25
+transmit = 0.5
+ior = 1
+"
+    );
+    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let tracer =
+        whitted::trace::reference::ReferenceTracer::new(&scene, scene.camera(1, 1).unwrap(), 5);
+    let (_, front) = tracer.inspect(0.5, 0.5);
+    let weights = |node: &whitted::trace::reference::RayNode| {
+        let shadows: Vec<f64> = node.shadows.iter().map(|s| s.weight).collect();
+        let children: Vec<f64> = node.children.iter().map(|c| c.weight).collect();
+        (node.weight, shadows, children)
+    };
+    assert_eq!(weights(&front), (1.0, vec![0.375], vec![0.125, 0.5]));
+    let back = &front.children[1];
+    assert!(back.hit.as_ref().is_some_and(|h| !h.entering));
+    assert_eq!(weights(back), (0.5, vec![0.1875], vec![0.0625, 0.25]));
+}
