@@ -503,6 +503,18 @@ horizontal = [2, 0, 0]
 vertical = [0, 2, 0]
 ";
 
+/// A scene seen through [`CAMERA`] in one pixel, whose ray is exactly −z; `rest` is
+/// its lights and spheres.
+fn one_pixel(rest: &str) -> String {
+    format!("{CAMERA}\n[image]\nwidth = 1\nheight = 1\n\n{rest}")
+}
+
+/// The `f64` reference tracer of `scene` for a one-pixel image, at the default depth.
+fn reference_tracer(scene: &Scene) -> whitted::trace::reference::ReferenceTracer<'_> {
+    let camera = scene.camera(1, 1).unwrap();
+    whitted::trace::reference::ReferenceTracer::new(scene, camera, 5)
+}
+
 /// Renders the scene with both renderers; returns (fast, reference).
 fn render_both(toml: &str) -> (Frame, Frame) {
     let scene = Scene::from_toml_str(toml, "test.toml").expect("a valid test scene");
@@ -589,13 +601,8 @@ color = [1.0, 0.5, 0.25]
 
 #[test]
 fn half_mirror_sphere_by_hand() {
-    let toml = format!(
-        "{CAMERA}
-[image]
-width = 1
-height = 1
-
-[[light]]
+    let toml = one_pixel(
+        "[[light]]
 position = [2, 0, 0]
 intensity = [1.0, 0.8, 0.5]
 
@@ -604,7 +611,7 @@ center = [0, 0, -3]
 radius = 1
 color = [1.0, 0.5, 0.25]
 reflect = 0.5
-"
+",
     );
     // As above, local = (1, 0.4, 0.125)/√2. Head-on, d − 2(d·n)n = (0, 0, 1): back past
     // the camera to the sky at d.y = 0, (0.75, 0.85, 1). Half of each.
@@ -955,13 +962,8 @@ transmit = {transmit}
 ///   skipped: colour 0, bound ¼ + ¼ + ⅛ + ⅛ + ¼ = 1; one primary and one secondary ray.
 #[test]
 fn the_cutoff_skips_branches_below_it_by_hand() {
-    let toml = format!(
-        "{CAMERA}
-[image]
-width = 1
-height = 1
-
-[[light]]
+    let toml = one_pixel(
+        "[[light]]
 position = [0, 0, 10]
 
 [[sphere]]
@@ -971,7 +973,7 @@ color = [1.0, 0.5, 0.25]
 reflect = 0.5
 transmit = 0.5
 ior = 1
-"
+",
     );
     let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
     let sky = DVec3::new(0.75, 0.85, 1.0);
@@ -1016,19 +1018,14 @@ ior = 1
 /// hits side by side.
 #[test]
 fn a_light_in_the_tangent_plane_casts_no_shadow_ray() {
-    let toml = format!(
-        "{CAMERA}
-[image]
-width = 1
-height = 1
-
-[[light]]
+    let toml = one_pixel(
+        "[[light]]
 position = [5, 0, -2]
 
 [[sphere]]
 center = [0, 0, -3]
 radius = 1
-"
+",
     );
     let one_ray = RayCounts {
         primary: 1,
@@ -1062,20 +1059,15 @@ radius = 1
 /// would see the ball's outside, facing away from the light: black.
 #[test]
 fn a_camera_on_a_ball_s_surface_sees_its_inside() {
-    let toml = format!(
-        "{CAMERA}
-[image]
-width = 1
-height = 1
-
-[[light]]
+    let toml = one_pixel(
+        "[[light]]
 position = [0, 0, -1]
 
 [[sphere]]
 center = [0, 0, -1]
 radius = 1
 color = [1.0, 0.5, 0.25]
-"
+",
     );
     assert_pixel(&render_both(&toml), 0, 0, DVec3::new(1.0, 0.5, 0.25));
 }
@@ -1088,13 +1080,8 @@ color = [1.0, 0.5, 0.25]
 /// its normal there, (0, 0, −1), faces the segment head-on.)
 #[test]
 fn a_ball_the_light_sits_on_casts_no_shadow_through_the_segment_s_end() {
-    let toml = format!(
-        "{CAMERA}
-[image]
-width = 1
-height = 1
-
-[[light]]
+    let toml = one_pixel(
+        "[[light]]
 position = [0, 0, 2]
 
 [[sphere]]
@@ -1105,7 +1092,7 @@ color = [1.0, 0.5, 0.25]
 [[sphere]]
 center = [0, 0, 3]
 radius = 1
-"
+",
     );
     assert_pixel(&render_both(&toml), 0, 0, DVec3::new(1.0, 0.5, 0.25));
 }
@@ -1151,24 +1138,18 @@ radius = 1
 /// about 10⁻⁶ and meet nothing.
 #[test]
 fn rays_leaving_a_ball_at_grazing_angles_never_meet_it_again() {
-    let toml = format!(
-        "{CAMERA}
-[image]
-width = 1
-height = 1
-
-[[light]]
+    let toml = one_pixel(
+        "[[light]]
 position = [0, 0, 10]
 
 [[sphere]]
 center = [0, 0, -3]
 radius = 1
 reflect = 0.5
-"
+",
     );
     let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
-    let camera = scene.camera(1, 1).unwrap();
-    let tracer = whitted::trace::reference::ReferenceTracer::new(&scene, camera, 5);
+    let tracer = reference_tracer(&scene);
     let tangent = 0.125f64.sqrt();
     let (mut hits, mut shadow_rays) = (0, 0);
     for k in 0..4000 {
@@ -1205,21 +1186,15 @@ reflect = 0.5
 /// (about 10⁻⁴ long), never at its spawn point.
 #[test]
 fn rays_inside_a_ball_at_grazing_angles_never_meet_it_at_their_start() {
-    let toml = format!(
-        "{CAMERA}
-[image]
-width = 1
-height = 1
-
-[[sphere]]
+    let toml = one_pixel(
+        "[[sphere]]
 center = [0, -0.99999999, 0]
 radius = 1
 transmit = 1
-"
+",
     );
     let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
-    let camera = scene.camera(1, 1).unwrap();
-    let tracer = whitted::trace::reference::ReferenceTracer::new(&scene, camera, 5);
+    let tracer = reference_tracer(&scene);
     let mut spawned = 0;
     for k in 0..1000 {
         let (s, t) = (k as f64 / 1000.0, 0.5 + 5e-4 * (k % 7) as f64 / 7.0);
@@ -1254,13 +1229,8 @@ transmit = 1
 /// is (1 − √0.19)/2 = 0.282; the second, at (0, 0, 6), head-on: factor 0, s = 0.
 #[test]
 fn the_ray_tree_names_the_occluder_of_least_factor() {
-    let toml = format!(
-        "{CAMERA}
-[image]
-width = 1
-height = 1
-
-[[light]]
+    let toml = one_pixel(
+        "[[light]]
 position = [0, 0, 10]
 
 [[sphere]]
@@ -1274,11 +1244,10 @@ radius = 1
 [[sphere]]
 center = [0, 0, 6]
 radius = 1
-"
+",
     );
     let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
-    let tracer =
-        whitted::trace::reference::ReferenceTracer::new(&scene, scene.camera(1, 1).unwrap(), 5);
+    let tracer = reference_tracer(&scene);
     let (colour, tree) = tracer.inspect(0.5, 0.5);
     assert_eq!(colour, DVec3::ZERO);
     let [shadow] = tree.shadows.as_slice() else {
@@ -1289,8 +1258,7 @@ radius = 1
     // Alone, the first ball sets the factor, and is named.
     let mut scene = scene;
     scene.spheres.pop();
-    let tracer =
-        whitted::trace::reference::ReferenceTracer::new(&scene, scene.camera(1, 1).unwrap(), 5);
+    let tracer = reference_tracer(&scene);
     let (_, tree) = tracer.inspect(0.5, 0.5);
     assert_eq!(tree.shadows[0].occluder, Some(1));
     let expected = (1.0 - 0.19f64.sqrt()) / 2.0;
@@ -1305,13 +1273,8 @@ radius = 1
 /// weigh half as much: 3/16, 1/16, ¼.
 #[test]
 fn the_ray_tree_weighs_each_term_by_its_path() {
-    let toml = format!(
-        "{CAMERA}
-[image]
-width = 1
-height = 1
-
-[[light]]
+    let toml = one_pixel(
+        "[[light]]
 position = [0, 0, 10]
 
 [[sphere]]
@@ -1320,11 +1283,10 @@ radius = 1
 reflect = 0.25
 transmit = 0.5
 ior = 1
-"
+",
     );
     let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
-    let tracer =
-        whitted::trace::reference::ReferenceTracer::new(&scene, scene.camera(1, 1).unwrap(), 5);
+    let tracer = reference_tracer(&scene);
     let (_, front) = tracer.inspect(0.5, 0.5);
     let weights = |node: &whitted::trace::reference::RayNode| {
         let shadows: Vec<f64> = node.shadows.iter().map(|s| s.weight).collect();
