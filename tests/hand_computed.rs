@@ -1298,3 +1298,37 @@ ior = 1
     assert!(back.hit.as_ref().is_some_and(|h| !h.entering));
     assert_eq!(weights(back), (0.5, vec![0.1875], vec![0.0625, 0.25]));
 }
+
+/// The fast tracer's primary rays look for spheres only among those that reach into
+/// the view (the camera's pyramid, widened by 10⁻³ of the film), and a sphere that
+/// reaches in by less than a millionth of its radius still counts. A ball of radius
+/// 10⁴ pokes 5·10⁻⁴ through the view's left side 4 away from the eye (the centre lies
+/// r − 5·10⁻⁴ outside the plane x = z, level with the eye; the cap inside the view has
+/// radius √(2·r·5·10⁻⁴) ≈ 3.2, so the eye is outside the ball), about 0.0095 into the
+/// widened pyramid, less than r·10⁻⁶ = 0.01. The three leftmost pixels of a
+/// 20,000-wide row see it, 0.9 to 1.5 from the eye (the fourth misses it); both
+/// tracers agree, pixel by pixel.
+#[test]
+fn a_ball_reaching_into_the_view_by_a_hair_is_seen() {
+    let toml = format!(
+        "{CAMERA}
+[image]
+width = 20000
+height = 1
+
+[[light]]
+position = [5, 0, -5]
+
+[[sphere]]
+center = [-7073.895885436829, 0, 7068.239031187338]
+radius = 10000
+"
+    );
+    let (fast, reference) = render_both(&toml);
+    let sky = default_sky(0.0);
+    for i in 0..8 {
+        let (f, r) = (fast.get(i, 0).as_dvec3(), reference.get(i, 0).as_dvec3());
+        assert!(close(f, r, 1e-5), "pixel {i}: fast {f}, reference {r}");
+        assert_eq!(close(r, sky, 1e-6), i >= 3, "pixel {i}: {r}");
+    }
+}
