@@ -509,6 +509,11 @@ fn one_pixel(rest: &str) -> String {
     format!("{CAMERA}\n[image]\nwidth = 1\nheight = 1\n\n{rest}")
 }
 
+/// The scene a test's TOML text describes.
+fn scene_of(toml: &str) -> Scene {
+    Scene::from_toml_str(toml, "test.toml").expect("a valid test scene")
+}
+
 /// The `f64` reference tracer of `scene` for a one-pixel image, at the default depth.
 fn reference_tracer(scene: &Scene) -> whitted::trace::reference::ReferenceTracer<'_> {
     let camera = scene.camera(1, 1).unwrap();
@@ -517,7 +522,7 @@ fn reference_tracer(scene: &Scene) -> whitted::trace::reference::ReferenceTracer
 
 /// Renders the scene with both renderers; returns (fast, reference).
 fn render_both(toml: &str) -> (Frame, Frame) {
-    let scene = Scene::from_toml_str(toml, "test.toml").expect("a valid test scene");
+    let scene = scene_of(toml);
     let mut opts = scene.settings();
     let control = RenderControl::default();
     let (fast, _) = render::render(&scene, &opts, &control).expect("fast render");
@@ -797,7 +802,7 @@ height = 1
 
 /// The rays a whole render of the scene `toml` casts, by kind, with `precision`'s tracer.
 fn rays_cast(toml: &str, precision: Precision) -> RayCounts {
-    let scene = Scene::from_toml_str(toml, "test.toml").expect("a valid test scene");
+    let scene = scene_of(toml);
     let mut opts = scene.settings();
     opts.quality.precision = precision;
     let (_, stats) = render::render(&scene, &opts, &RenderControl::default()).unwrap();
@@ -975,7 +980,7 @@ transmit = 0.5
 ior = 1
 ",
     );
-    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let scene = scene_of(&toml);
     let sky = DVec3::new(0.75, 0.85, 1.0);
     let local = DVec3::new(1.0, 0.5, 0.25);
     for (cutoff, colour, bound, rays) in [
@@ -1037,7 +1042,7 @@ radius = 1
     }
     assert_pixel(&render_both(&toml), 0, 0, DVec3::ZERO);
 
-    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let scene = scene_of(&toml);
     let tracer = render::make_tracer(&scene, &scene.settings()).unwrap();
     let (mut out, mut rays) = ([Vec3::ONE; 2], RayCounts::default());
     tracer.sample_row(&[0.5, 0.5], 0.5, &mut out, &mut rays);
@@ -1148,7 +1153,7 @@ radius = 1
 reflect = 0.5
 ",
     );
-    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let scene = scene_of(&toml);
     let tracer = reference_tracer(&scene);
     let tangent = 0.125f64.sqrt();
     let (mut hits, mut shadow_rays) = (0, 0);
@@ -1193,7 +1198,7 @@ radius = 1
 transmit = 1
 ",
     );
-    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let scene = scene_of(&toml);
     let tracer = reference_tracer(&scene);
     let mut spawned = 0;
     for k in 0..1000 {
@@ -1246,7 +1251,7 @@ center = [0, 0, 6]
 radius = 1
 ",
     );
-    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let scene = scene_of(&toml);
     let tracer = reference_tracer(&scene);
     let (colour, tree) = tracer.inspect(0.5, 0.5);
     assert_eq!(colour, DVec3::ZERO);
@@ -1285,7 +1290,7 @@ transmit = 0.5
 ior = 1
 ",
     );
-    let scene = Scene::from_toml_str(&toml, "test.toml").expect("a valid test scene");
+    let scene = scene_of(&toml);
     let tracer = reference_tracer(&scene);
     let (_, front) = tracer.inspect(0.5, 0.5);
     let weights = |node: &whitted::trace::reference::RayNode| {

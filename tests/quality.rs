@@ -127,10 +127,10 @@ fn cutoff_skips_work_and_reports_a_nonzero_bound_on_hw3() {
 #[test]
 fn a_row_of_samples_is_its_samples_one_by_one_at_any_cutoff() {
     let (scene, mut opts) = hw3_opts(96, 54, 1);
+    let s: Vec<f32> = (0..96).map(|i| (i as f32 + 0.5) / 96.0).collect();
     for cutoff in [0.0, 0.05, 0.25, 1.5] {
         opts.quality.cutoff = cutoff;
         let tracer = make_tracer(&scene, &opts).unwrap();
-        let s: Vec<f32> = (0..96).map(|i| (i as f32 + 0.5) / 96.0).collect();
         let mut black = 0;
         for j in 0..54 {
             let t = (j as f32 + 0.5) / 54.0;
