@@ -16,7 +16,7 @@ use super::{list_radius, round_up, Query, WALK_INSIDE_FROM};
 use crate::model::Side;
 
 /// A proptest runner of `cases` cases with a fixed seed and no persisted failures.
-fn runner(cases: u32) -> TestRunner {
+pub(super) fn runner(cases: u32) -> TestRunner {
     TestRunner::new_with_rng(
         Config {
             cases,
@@ -66,12 +66,12 @@ fn roots64(o: DVec3, d: DVec3, c: DVec3, r: f64) -> Option<(f64, f64)> {
 }
 
 /// Log-uniform `10^U(lo, hi)`.
-fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
+pub(super) fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
     (lo..hi).prop_map(|e: f64| 10f64.powf(e))
 }
 
 /// A uniformly distributed unit vector.
-fn unit_vector() -> impl Strategy<Value = DVec3> {
+pub(super) fn unit_vector() -> impl Strategy<Value = DVec3> {
     (-1.0f64..1.0, 0.0f64..std::f64::consts::TAU).prop_map(|(z, phi)| {
         let s = (1.0 - z * z).sqrt();
         DVec3::new(s * phi.cos(), s * phi.sin(), z)
