@@ -105,7 +105,7 @@ pub(crate) type EyeGrid = PointGrid;
 /// One sphere as the quick test of rays through a grid's point sees it (see
 /// [`PointQuick::may_cross`]).
 #[derive(Clone, Copy)]
-struct PointQuick {
+pub(super) struct PointQuick {
     /// `point − centre` in `f32`.
     f: Vec3,
     /// A ray of unit direction `d` misses when `(f·d)²` is below this: the closest
@@ -120,7 +120,7 @@ struct PointQuick {
 }
 
 impl PointQuick {
-    fn new(point: DVec3, centre: DVec3, quick: Vec4) -> Self {
+    pub(super) fn new(point: DVec3, centre: DVec3, quick: Vec4) -> Self {
         // The quantities of `Spheres::may_cross` for this origin, with the test
         // `|l|² > r² + slack` rewritten as `(f·d)² < |f|² − r² − slack`
         // (`|l|² = |f|² − (f·d)²`). The rewrite adds rounding of a few ε·|f|², far
@@ -149,7 +149,7 @@ impl PointQuick {
     /// `false` when a ray from the point with unit direction `d` certainly misses the
     /// sphere in `(0, t_max)`.
     #[inline(always)]
-    fn may_cross(&self, d: Vec3, t_max: f32) -> bool {
+    pub(super) fn may_cross(&self, d: Vec3, t_max: f32) -> bool {
         let bp = -self.f.dot(d);
         // `&`, not `&&`: one branch on the outcome, not three on its parts.
         (bp * bp >= self.min_bp2) & (bp + self.reach > 0.0) & (bp - self.reach < t_max)
@@ -161,7 +161,7 @@ impl PointQuick {
     /// half chord plus the slack. (Shadow rays: bounded by the radius, most spheres
     /// that pass lie just beyond the hit point and are not crossed by the segment.)
     #[inline(always)]
-    fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
+    pub(super) fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
         let bp = -self.f.dot(d);
         let chord2 = bp * bp + offset * (2.0 * self.radius + offset) - self.min_bp2;
         // NaN when the line misses (chord2 < 0): it fails every comparison.
@@ -437,172 +437,5 @@ impl<'a> ShadowStart<'a> {
             offset: (4e-7 * dist) as f32,
             candidates: grid.candidates(grid.cell((q.origin - grid.centre).as_vec3())),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    //! The quick tests against the `f64` geometry of the sphere they stand for: never
-    //! `false` for a ray that crosses it (the exact test would have found a hit), and
-    //! `false` for a ray that clearly misses it (the work they exist to skip).
-    use std::cell::Cell;
-
-    use glam::{DVec3, Vec4};
-    use proptest::strategy::Strategy;
-
-    use super::PointQuick;
-    use crate::accel::tests::{log_uniform, runner, unit_vector};
-
-    /// A ray from a point against a sphere, the geometry in `f64`.
-    #[derive(Debug)]
-    struct Case {
-        point: DVec3,
-        centre: DVec3,
-        radius: f32,
-        /// The ray's direction, a unit vector in `f32`.
-        d: glam::Vec3,
-        t_max: f32,
-        /// How far the quick test's line may pass from the point (`may_cross_near`).
-        offset: f32,
-    }
-
-    /// A sphere of radius 10^U(−2, 2) around a random centre, a line through it at
-    /// U(0, 1.6) radii from the centre, the point on that line U(−60, 60) radii from
-    /// the foot of the perpendicular (inside the sphere, just outside and far away),
-    /// `t_max` anything from 0 to beyond the sphere, and an offset of 0, or up to a
-    /// radius.
-    fn cases() -> impl Strategy<Value = Case> {
-        (
-            log_uniform(-2.0, 2.0),
-            unit_vector(),
-            unit_vector(),
-            unit_vector(),
-            0.0f64..1.6,
-            -60.0f64..60.0,
-            0.0f64..130.0,
-            (0.0f64..1.0, 0.0f64..1.0),
-        )
-            .prop_map(|(r, c_dir, d, e, line, along, reach, (pick, o))| {
-                let radius = r as f32;
-                let r = f64::from(radius);
-                let centre = c_dir * (10.0 * r);
-                let d = d.as_vec3().normalize();
-                let d64 = d.as_dvec3();
-                // A unit vector across the ray.
-                let across = (e - d64 * e.dot(d64)).normalize_or(d64.any_orthonormal_vector());
-                // The point's offset from the centre: `line` radii across the ray and
-                // `along` radii back from the foot of the perpendicular.
-                let point = centre + across * (line * r) - d64 * (along * r);
-                let t_max = if reach > 125.0 {
-                    f32::INFINITY
-                } else {
-                    (reach * r) as f32
-                };
-                let offset = if pick < 0.3 { 0.0 } else { (o * r) as f32 };
-                Case {
-                    point,
-                    centre,
-                    radius,
-                    d,
-                    t_max,
-                    offset,
-                }
-            })
-    }
-
-    /// What the quick test must answer for a ray from `c.point` against the sphere
-    /// widened by `widen`: `Some(true)` when the ray meets it at a distance in
-    /// `(0, t_max)` (by a margin), `Some(false)` when its line passes outside it or its
-    /// crossings, stretched by `stretch` each way, lie all before 0 or all beyond
-    /// `t_max` (by a margin), `None` when it is too close to call.
-    fn expected(c: &Case, widen: f64, stretch: f64) -> Option<bool> {
-        let d = c.d.as_dvec3().normalize();
-        let f = c.point - c.centre;
-        let r = f64::from(c.radius) + widen;
-        let t_max = f64::from(c.t_max);
-        // Far beyond the quick tests' slack of 2⁻¹⁸ relative.
-        let margin = 1e-4 * (r + f.length());
-        let along = -f.dot(d);
-        let line2 = f.cross(d).length_squared();
-        if line2 > r * r + margin * (r + f.length()) {
-            return Some(false);
-        }
-        if line2 > r * r {
-            return None;
-        }
-        let half = (r * r - line2).sqrt();
-        let (near, far) = (along - half, along + half);
-        let meets = |t: f64| t > margin && t < t_max - margin;
-        if meets(near) || meets(far) {
-            return Some(true);
-        }
-        if far + stretch < -margin || near - stretch > t_max + margin {
-            return Some(false);
-        }
-        None
-    }
-
-    fn quick(c: &Case) -> PointQuick {
-        let centre = c.centre.as_vec3();
-        PointQuick::new(
-            c.point,
-            c.centre,
-            Vec4::new(centre.x, centre.y, centre.z, c.radius),
-        )
-    }
-
-    /// `may_cross` bounds the crossings by the radius, not the half chord: a ray is
-    /// rejected as passing before 0 or beyond `t_max` only if the whole radius is.
-    #[test]
-    fn may_cross_passes_every_ray_that_meets_the_sphere_and_rejects_clear_misses() {
-        let (passed, rejected) = (Cell::new(0), Cell::new(0));
-        runner(4000)
-            .run(&cases(), |c| {
-                let got = quick(&c).may_cross(c.d, c.t_max);
-                let f = c.point - c.centre;
-                let d = c.d.as_dvec3().normalize();
-                // The crossings lie within `r` of `along`; stretch the chord to it.
-                let r = f64::from(c.radius);
-                let half2 = r * r - f.cross(d).length_squared();
-                let stretch = r - half2.max(0.0).sqrt();
-                if let Some(want) = expected(&c, 0.0, stretch) {
-                    assert_eq!(got, want, "{c:?}");
-                    let count = if want { &passed } else { &rejected };
-                    count.set(count.get() + 1);
-                }
-                Ok(())
-            })
-            .unwrap();
-        let (passed, rejected) = (passed.get(), rejected.get());
-        println!("{passed} passed, {rejected} rejected, the rest too close to call");
-        assert!(
-            passed > 800 && rejected > 2000,
-            "{passed} passed, {rejected} rejected"
-        );
-    }
-
-    /// `may_cross_near` stands for every ray whose origin lies within `offset` of the
-    /// point: the sphere widened by `offset`, its crossings stretched by `offset`.
-    #[test]
-    fn may_cross_near_passes_every_ray_within_its_offset_and_rejects_clear_misses() {
-        let (passed, rejected) = (Cell::new(0), Cell::new(0));
-        runner(4000)
-            .run(&cases(), |c| {
-                let got = quick(&c).may_cross_near(c.d, c.t_max, c.offset);
-                let o = f64::from(c.offset);
-                if let Some(want) = expected(&c, o, o) {
-                    assert_eq!(got, want, "{c:?}");
-                    let count = if want { &passed } else { &rejected };
-                    count.set(count.get() + 1);
-                }
-                Ok(())
-            })
-            .unwrap();
-        let (passed, rejected) = (passed.get(), rejected.get());
-        println!("{passed} passed, {rejected} rejected, the rest too close to call");
-        assert!(
-            passed > 800 && rejected > 2000,
-            "{passed} passed, {rejected} rejected"
-        );
     }
 }

@@ -6,6 +6,7 @@
 
 mod culling;
 mod intersection;
+mod quick;
 mod refraction;
 
 use glam::DVec3;

@@ -1,0 +1,222 @@
+//! The quick tests and boxes in front of the exact tests, against the `f64` geometry
+//! of the sphere they stand for: never `false` for a ray that meets it, nor a box that
+//! cuts it (the exact test would have found a hit there), and `false` for a ray that
+//! clearly misses it, a box that clearly fits (the work they exist to skip).
+
+use std::cell::Cell;
+
+use glam::{DVec3, Vec3, Vec4};
+use proptest::prelude::*;
+
+use super::*;
+use crate::accel::point::PointQuick;
+use crate::accel::{may_cross, quick_sphere, sphere_box, Ray};
+
+/// A ray from a point against a sphere, the geometry in `f64`.
+#[derive(Debug)]
+struct Case {
+    point: DVec3,
+    centre: DVec3,
+    radius: f32,
+    /// The ray's direction, a unit vector in `f32`.
+    d: Vec3,
+    t_max: f32,
+    /// How far the quick test's line may pass from the point (`may_cross_near`).
+    offset: f32,
+}
+
+impl Case {
+    /// The half chord of the sphere widened by `widen` along the ray's line (0 when
+    /// the line misses it).
+    fn half_chord(&self, widen: f64) -> f64 {
+        let r = f64::from(self.radius) + widen;
+        let line = (self.point - self.centre).cross(self.d.as_dvec3().normalize());
+        (r * r - line.length_squared()).max(0.0).sqrt()
+    }
+}
+
+/// A sphere of radius 10^U(−2, 2) 10 radii from the origin, a line at U(0, 1.6)
+/// radii from its centre, the point on that line U(−60, 60) radii from the foot of
+/// the perpendicular (inside the sphere, just outside and far away), `t_max` anything
+/// from 0 to beyond the sphere, and an offset of 0 or up to a radius.
+fn cases() -> impl Strategy<Value = Case> {
+    (
+        log_uniform(-2.0, 2.0),
+        unit_vector(),
+        unit_vector(),
+        unit_vector(),
+        0.0f64..1.6,
+        -60.0f64..60.0,
+        0.0f64..130.0,
+        (0.0f64..1.0, 0.0f64..1.0),
+    )
+        .prop_map(|(r, c_dir, d, e, line, along, reach, (pick, o))| {
+            let radius = r as f32;
+            let r = f64::from(radius);
+            let centre = c_dir * (10.0 * r);
+            let d = d.as_vec3().normalize();
+            let d64 = d.as_dvec3();
+            let across = (e - d64 * e.dot(d64)).normalize_or(d64.any_orthonormal_vector());
+            let point = centre + across * (line * r) - d64 * (along * r);
+            let t_max = if reach > 125.0 {
+                f32::INFINITY
+            } else {
+                (reach * r) as f32
+            };
+            let offset = if pick < 0.3 { 0.0 } else { (o * r) as f32 };
+            Case {
+                point,
+                centre,
+                radius,
+                d,
+                t_max,
+                offset,
+            }
+        })
+}
+
+/// What a quick test must answer for the ray of `c` against its sphere widened by
+/// `widen`: `Some(true)` when the ray meets it at a distance in `(0, t_max)` (by a
+/// margin), `Some(false)` when its line passes outside it, or its crossings,
+/// stretched by `stretch` each way, lie all before 0 or all beyond `t_max` (by a
+/// margin), `None` when it is too close to call.
+fn expected(c: &Case, widen: f64, stretch: f64) -> Option<bool> {
+    let d = c.d.as_dvec3().normalize();
+    let f = c.point - c.centre;
+    let r = f64::from(c.radius) + widen;
+    let t_max = f64::from(c.t_max);
+    // 25 times the quick tests' slack of 2⁻¹⁸ relative.
+    let margin = 1e-4 * (r + f.length());
+    let along = -f.dot(d);
+    let line2 = f.cross(d).length_squared();
+    if line2 > r * r + margin * (r + f.length()) {
+        return Some(false);
+    }
+    if line2 > r * r {
+        return None;
+    }
+    let half = c.half_chord(widen);
+    let (near, far) = (along - half, along + half);
+    let meets = |t: f64| t > margin && t < t_max - margin;
+    if meets(near) || meets(far) {
+        return Some(true);
+    }
+    if far + stretch < -margin || near - stretch > t_max + margin {
+        return Some(false);
+    }
+    None
+}
+
+/// Runs `quick` on 4,000 cases against [`expected`] with the widening and stretch
+/// `bounds` gives, and checks that both answers were asked for often.
+fn check(name: &str, quick: impl Fn(&Case) -> bool, bounds: impl Fn(&Case) -> (f64, f64)) {
+    let (passed, rejected) = (Cell::new(0), Cell::new(0));
+    runner(4000)
+        .run(&cases(), |c| {
+            let (widen, stretch) = bounds(&c);
+            if let Some(want) = expected(&c, widen, stretch) {
+                assert_eq!(quick(&c), want, "{c:?}");
+                let count = if want { &passed } else { &rejected };
+                count.set(count.get() + 1);
+            }
+            Ok(())
+        })
+        .unwrap();
+    let (passed, rejected) = (passed.get(), rejected.get());
+    println!("{name}: {passed} passed, {rejected} rejected, the rest too close to call");
+    assert!(
+        passed > 800 && rejected > 2000,
+        "{passed} passed, {rejected} rejected"
+    );
+}
+
+/// The quick test of a ray of any origin ([`may_cross`]): the sphere itself.
+#[test]
+fn the_quick_test_passes_every_ray_that_meets_the_sphere_and_rejects_clear_misses() {
+    check(
+        "may_cross",
+        |c| {
+            let q = Query {
+                origin: c.point,
+                dir: c.d,
+                from: None,
+            };
+            may_cross(c.centre, c.radius, &Ray::new(&q), c.t_max)
+        },
+        |_| (0.0, 0.0),
+    );
+}
+
+fn point_quick(c: &Case) -> PointQuick {
+    let centre = c.centre.as_vec3();
+    PointQuick::new(c.point, c.centre, centre.extend(c.radius))
+}
+
+/// The quick test of a ray through a grid's point bounds the crossings by the radius,
+/// not the half chord: a ray is rejected as passing before 0 or beyond `t_max` only if
+/// the whole radius is.
+#[test]
+fn the_point_s_quick_test_passes_every_ray_that_meets_the_sphere_and_rejects_clear_misses() {
+    check(
+        "PointQuick::may_cross",
+        |c| point_quick(c).may_cross(c.d, c.t_max),
+        |c| (0.0, f64::from(c.radius) - c.half_chord(0.0)),
+    );
+}
+
+/// `may_cross_near` stands for every ray whose origin lies within `offset` of the
+/// point: the sphere widened by `offset`, its crossings stretched by `offset`.
+#[test]
+fn the_near_quick_test_passes_every_ray_within_its_offset_and_rejects_clear_misses() {
+    check(
+        "PointQuick::may_cross_near",
+        |c| point_quick(c).may_cross_near(c.d, c.t_max, c.offset),
+        |c| (f64::from(c.offset), f64::from(c.offset)),
+    );
+}
+
+/// A sphere of radius 10^U(−3, 5) with its centre 10^U(−2, 5) from the origin.
+fn sphere() -> impl Strategy<Value = (DVec3, f64)> {
+    (
+        log_uniform(-2.0, 5.0),
+        unit_vector(),
+        log_uniform(-3.0, 5.0),
+    )
+        .prop_map(|(d, u, r)| (u * d, r))
+}
+
+/// The quick test's `f32` sphere holds the `f64` one, and is larger by no more than a
+/// few units of `f32` rounding of the centre's and radius's size.
+#[test]
+fn the_quick_sphere_holds_the_sphere_and_little_more() {
+    runner(4000)
+        .run(&sphere(), |(c, r)| {
+            let q: Vec4 = quick_sphere(c, r);
+            let (c32, w) = (q.truncate().as_dvec3(), f64::from(q.w));
+            let scale = c.abs().max_element() + r;
+            assert!((c32 - c).length() + r <= w, "{c} {r}: {q}");
+            assert!(w - r <= 1e-6 * scale, "{c} {r}: {q}");
+            Ok(())
+        })
+        .unwrap();
+}
+
+/// The hierarchy's `f32` box of a sphere holds it, and is larger by no more than a
+/// few millionths of the sphere's size and distance from the origin.
+#[test]
+fn the_box_of_a_sphere_holds_it_and_little_more() {
+    runner(4000)
+        .run(&sphere(), |(c, r)| {
+            let b = sphere_box(c, r);
+            let (lo, hi) = (b.min.as_dvec3(), b.max.as_dvec3());
+            let scale = c.abs().max_element() + r;
+            assert!(
+                lo.cmple(c - r).all() && hi.cmpge(c + r).all(),
+                "{c} {r}: {lo} {hi}"
+            );
+            let slack = (c - r - lo).max(hi - c - r).max_element();
+            assert!(slack <= 3e-6 * scale, "{c} {r}: {slack:e}");
+            Ok(())
+        })
+        .unwrap();
+}
