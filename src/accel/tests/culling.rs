@@ -164,10 +164,12 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                         continue;
                     }
                     let want = sorted.first().map(|x| x.0 as u32);
+                    let pair = set.closest_from_eye_pair(&eye_grid, q.dir, -q.dir);
                     for (name, got) in [
                         ("closest", set.closest(&q)),
                         ("closest_primary", set.closest_primary(&eye_grid, &q)),
                         ("closest_from_eye", set.closest_from_eye(&eye_grid, q.dir)),
+                        ("closest_from_eye_pair", pair[0]),
                     ] {
                         let got_k = got.map(|h| h.sphere);
                         if got_k != want {
@@ -184,6 +186,21 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                     prop_assert_eq!(
                         general.map(|h| (h.point, h.normal, h.entering)),
                         from_eye.map(|h| (h.point, h.normal, h.entering))
+                    );
+                    // The pair's second ray, the other way, is the general query's too.
+                    let back = Query { dir: -q.dir, ..q };
+                    prop_assert_eq!(
+                        set.closest(&back).map(|h| (h.point, h.normal, h.entering)),
+                        pair[1].map(|h| (h.point, h.normal, h.entering))
+                    );
+                    // The eye grid is no use to a ray from elsewhere: the primary query
+                    // hands it to the general one.
+                    let elsewhere = Query { origin: light, ..q };
+                    prop_assert_eq!(
+                        set.closest(&elsewhere)
+                            .map(|h| (h.point, h.normal, h.entering)),
+                        set.closest_primary(&eye_grid, &elsewhere)
+                            .map(|h| (h.point, h.normal, h.entering))
                     );
                     // A shadow ray from the hit towards the light, through grid and BVH.
                     let Some(hit) = set.closest(&q) else { continue };
