@@ -404,7 +404,98 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
 
 #[cfg(test)]
 mod tests {
-    use super::{from_ordered_bits, ordered_bits};
+    use glam::DVec3;
+
+    use super::{from_ordered_bits, ordered_bits, DirGrid};
+
+    /// What a grid lists, against the spheres' geometry in `f64` and directions drawn at
+    /// random (each placed in its cell by the queries' own [`DirGrid::cell`]): a sphere
+    /// is listed in the cell of every direction it is seen in; a cell lists it only if
+    /// it is seen within 0.6 of a cell's half-width of some direction of that cell (a
+    /// cell's cone circumscribes its square, which reaches 0.45 of it beyond the
+    /// square's sides); each entry's distance is the sphere's nearest distance rounded
+    /// down by at most 3·10⁻⁶ relative; each cell's list runs nearest first; and the
+    /// spheres around the centre are `always`, and only they.
+    #[test]
+    fn cells_list_the_spheres_seen_in_them_and_no_others() {
+        let mut rng = rand_mt::Mt64::new(11);
+        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut direction = || {
+            let (z, phi) = (2.0 * unit() - 1.0, std::f64::consts::TAU * unit());
+            let s = (1.0 - z * z).sqrt();
+            DVec3::new(s * phi.cos(), s * phi.sin(), z)
+        };
+        let centre = DVec3::new(0.3, -1.7, 2.2);
+        let n = 8;
+        // Seen at angular radii from 10⁻³ to 60 degrees, and three around the centre.
+        let mut spheres = Vec::new();
+        for k in 0..160 {
+            let dist = 10f64.powf(-1.0 + 3.0 * (k as f64 / 160.0));
+            let sin = 10f64
+                .powf(-3.0 + 3.0 * ((k * 37 % 160) as f64 / 160.0))
+                .min(0.87);
+            spheres.push((centre + direction() * dist, dist * sin));
+        }
+        for r in [0.5, 3.0, 40.0] {
+            spheres.push((centre + direction() * (0.7 * r), r));
+        }
+        let grid = DirGrid::build(centre, &spheres, n, None);
+
+        let samples: Vec<DVec3> = (0..400_000).map(|_| direction()).collect();
+        let mut by_cell = vec![Vec::new(); 6 * (n * n) as usize];
+        for &d in &samples {
+            by_cell[grid.cell(d.as_vec3())].push(d);
+        }
+        let mut always: Vec<u32> = grid.always.clone();
+        always.sort_unstable();
+        let around: Vec<u32> = (0..spheres.len() as u32)
+            .filter(|&k| {
+                let (c, r) = spheres[k as usize];
+                (c - centre).length() <= r
+            })
+            .collect();
+        assert_eq!(always, around);
+
+        let half_width = 1.0 / f64::from(n);
+        let (mut entries, mut widest) = (0, 0.0f64);
+        for (cell, seen) in by_cell.iter().enumerate() {
+            let list = grid.candidates(cell);
+            assert!(list.windows(2).all(|w| w[0].1 <= w[1].1), "cell {cell}");
+            for (k, (c, r)) in spheres.iter().enumerate() {
+                let rel = *c - centre;
+                let dist = rel.length();
+                if dist <= *r {
+                    continue;
+                }
+                let (axis, half) = (rel / dist, (r / dist).asin());
+                // How far outside the sphere's cone the cell's nearest direction lies.
+                let outside = seen
+                    .iter()
+                    .map(|d| d.dot(axis).clamp(-1.0, 1.0).acos() - half)
+                    .fold(f64::INFINITY, f64::min);
+                let entry = list.iter().find(|e| e.0 == k as u32);
+                if outside < -1e-9 {
+                    assert!(entry.is_some(), "cell {cell}: sphere {k} seen, not listed");
+                }
+                if let Some(&(_, near)) = entry {
+                    entries += 1;
+                    widest = widest.max(outside / half_width);
+                    assert!(
+                        outside <= 0.6 * half_width,
+                        "cell {cell}: sphere {k} listed, {outside} outside"
+                    );
+                    let exact = dist - r;
+                    let scale = dist + r + centre.abs().max_element();
+                    assert!(
+                        f64::from(near) <= exact && f64::from(near) >= exact - 3e-6 * scale,
+                        "sphere {k}: {near} for {exact}"
+                    );
+                }
+            }
+        }
+        println!("{entries} entries, the farthest {widest:.3} of a half-width outside");
+        assert!(entries > 1500, "{entries} entries");
+    }
 
     /// The sort keys order numbers as `total_cmp` does, negatives and zeros included.
     #[test]
