@@ -499,6 +499,22 @@ fn rays_inside_a_sphere_meet_what_brute_force_meets() {
             let with_lists = Spheres::new(&spheres);
             let mut walking = Spheres::new(&spheres);
             walking.list_radius = f64::INFINITY;
+            // A sphere's list holds the spheres that overlap or touch it, and no
+            // other (by a margin of 10⁻⁵ of the two radii).
+            for (s, sphere) in spheres.iter().enumerate() {
+                let list = with_lists.overlapping(s as u32);
+                for (k, other) in spheres.iter().enumerate() {
+                    let sum = sphere.radius + other.radius;
+                    let gap = (other.center - sphere.center).length() - sum;
+                    let far = sphere.center.abs().max_element() + other.center.abs().max_element();
+                    let listed = list.contains(&(k as u32));
+                    if k == s || gap > 1e-5 * sum + 1e-8 * far {
+                        prop_assert!(!listed, "sphere {k} in the list of {s}, {gap:e} apart");
+                    } else if gap < 0.0 {
+                        prop_assert!(listed, "sphere {k} not in the list of {s}, {gap:e} apart");
+                    }
+                }
+            }
             let mut c = counts.borrow_mut();
             for &(pick, n, towards) in &rays {
                 let s = ((pick * spheres.len() as f64) as usize).min(spheres.len() - 1);
