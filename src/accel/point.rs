@@ -323,22 +323,20 @@ impl Spheres {
             let Some(rt) = roots_from(sphere.f, sphere.cterm, d64, r) else {
                 continue;
             };
-            // `crossing` for a ray with no spawn sphere and `t_min = 0`.
-            let inv_r = sphere.inv_radius;
-            let (t, entering, normal) = if rt.near > 0.0 && rt.near < best.t {
-                (rt.near, true, rt.normal_near_scaled(d64, inv_r))
-            } else if rt.far > 0.0 && rt.far < best.t {
-                (rt.far, false, rt.normal_far_scaled(d64, inv_r))
-            } else {
+            // `crossing` for a ray with no spawn sphere and `t_min = 0`, from outside
+            // the sphere (a sphere around the eye is in the grid's `always`, and then
+            // the general query runs): `cterm > 0`, both roots have one sign, and a
+            // sphere in front is met at its near root.
+            if !(rt.near > 0.0 && rt.near < best.t) {
                 continue;
-            };
+            }
             best = Best {
-                t,
+                t: rt.near,
                 k,
-                entering,
-                normal,
+                entering: true,
+                normal: rt.normal_near_scaled(d64, sphere.inv_radius),
             };
-            t_max = round_up(t);
+            t_max = round_up(rt.near);
         }
         self.finish(best)
     }
