@@ -654,6 +654,65 @@ mod tests {
         }
     }
 
+    /// The walk visits boxes nearest first and skips those beyond the closest hit
+    /// found: a ray along a row of 10,000 boxes that hits the first one visits only
+    /// that box's leaf; one that hits none visits every box once, leaf after leaf in
+    /// the order of the row. The row's order is shuffled in the item indices, so that
+    /// the build, not the indices, puts them in order.
+    #[test]
+    fn the_walk_visits_boxes_nearest_first_and_stops_at_the_first_hit() {
+        let n = 10_000;
+        // Item k's box is the (k·7919 mod n)-th of the row, each 3 apart on x.
+        let place = |k: usize| (k * 7919 % n) as f32;
+        let boxes: Vec<Aabb> = (0..n)
+            .map(|k| Aabb {
+                min: Vec3A::new(3.0 * place(k), 0.0, 0.0),
+                max: Vec3A::new(3.0 * place(k) + 1.0, 1.0, 1.0),
+            })
+            .collect();
+        let bvh = Bvh::build(n, |k| boxes[k]);
+        let o = Vec3::new(-10.0, 0.5, 0.5);
+        let inv_d = Vec3::X.recip();
+        // A hit inside each box visited, at its entry distance.
+        let mut visited = Vec::new();
+        bvh.traverse(o, inv_d, f32::INFINITY, |slot, _| {
+            let k = bvh.items()[slot as usize] as usize;
+            visited.push(place(k));
+            Some(boxes[k].min.x - o.x)
+        });
+        // Exactly the leaf of the first box: the next leaf's box is entered at t = 19
+        // at the nearest, beyond the hit at 10.
+        let first_slot = bvh.items().iter().position(|&k| place(k as usize) == 0.0);
+        let leaf: Vec<f32> = bvh
+            .nodes
+            .iter()
+            .flat_map(|node| (0..WIDTH).map(move |lane| (node.child[lane], node.count[lane])))
+            .map(|(child, count)| child as usize..child as usize + usize::from(count))
+            .find(|slots| first_slot.is_some_and(|s| slots.contains(&s)))
+            .expect("the first box is in a leaf")
+            .map(|slot| place(bvh.items()[slot] as usize))
+            .collect();
+        let first = |v: &[f32]| format!("{:?}", &v[..v.len().min(20)]);
+        assert_eq!(visited, leaf, "{}", first(&visited));
+        // No hit: every box, and no box before one of an earlier leaf.
+        let mut visited = Vec::new();
+        bvh.traverse(o, inv_d, f32::INFINITY, |slot, _| {
+            visited.push(place(bvh.items()[slot as usize] as usize));
+            None
+        });
+        assert_eq!(visited.len(), n);
+        let mut sorted = visited.clone();
+        sorted.sort_by(f32::total_cmp);
+        assert!(sorted.windows(2).all(|w| w[0] < w[1]), "each box once");
+        // Within a leaf the order is the leaf's; across leaves, the row's.
+        let behind = visited
+            .iter()
+            .enumerate()
+            .filter(|&(i, &p)| visited[..i].iter().any(|&q| q > p + LARGEST_LEAF as f32))
+            .count();
+        assert_eq!(behind, 0, "{}", first(&visited));
+    }
+
     /// Boxes that share one centre (concentric spheres) cannot be split by position:
     /// they still land in leaves of at most `LARGEST_LEAF` (a leaf's count is a byte),
     /// and a ray through the centre meets every one of them exactly once.
