@@ -427,7 +427,7 @@ mod tests {
         };
         let centre = DVec3::new(0.3, -1.7, 2.2);
         let n = 8;
-        // Seen at angular radii from 10⁻³ to 60 degrees, and three around the centre.
+        // Seen at angular radii from 10⁻³ to 60 degrees, and four around the centre.
         let mut spheres = Vec::new();
         for k in 0..160 {
             let dist = 10f64.powf(-1.0 + 3.0 * (k as f64 / 160.0));
@@ -439,6 +439,8 @@ mod tests {
         for r in [0.5, 3.0, 40.0] {
             spheres.push((centre + direction() * (0.7 * r), r));
         }
+        // And one whose surface passes a ten-millionth of its radius beyond the centre.
+        spheres.push((centre + direction() * (2.0 * (1.0 - 1e-7)), 2.0));
         let grid = DirGrid::build(centre, &spheres, n, None);
 
         let samples: Vec<DVec3> = (0..400_000).map(|_| direction()).collect();
