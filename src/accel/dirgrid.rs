@@ -441,9 +441,24 @@ mod tests {
         }
         // And one whose surface passes a ten-millionth of its radius beyond the centre.
         spheres.push((centre + direction() * (2.0 * (1.0 - 1e-7)), 2.0));
+        // Directions on the cube's edges and corners, where two or three faces meet
+        // and a face coordinate is ±1 exactly, each with a sphere seen around it.
+        let mut diagonals = Vec::new();
+        for x in [-1.0, 0.0, 1.0] {
+            for y in [-1.0, 0.0, 1.0] {
+                for z in [-1.0, 0.0, 1.0] {
+                    let d = DVec3::new(x, y, z);
+                    if d.abs().element_sum() >= 2.0 {
+                        diagonals.push(d);
+                        spheres.push((centre + d.normalize() * 5.0, 0.5));
+                    }
+                }
+            }
+        }
         let grid = DirGrid::build(centre, &spheres, n, None);
 
-        let samples: Vec<DVec3> = (0..400_000).map(|_| direction()).collect();
+        let mut samples: Vec<DVec3> = (0..400_000).map(|_| direction()).collect();
+        samples.extend(diagonals.iter().map(|d| d.normalize()));
         let mut by_cell = vec![Vec::new(); 6 * (n * n) as usize];
         for &d in &samples {
             by_cell[grid.cell(d.as_vec3())].push(d);
