@@ -463,6 +463,14 @@ mod tests {
         for &d in &samples {
             by_cell[grid.cell(d.as_vec3())].push(d);
         }
+        // Each cell its own directions: some in every one, about as many in each as its
+        // solid angle (a corner cell's is 0.19 of a central one's at n = 8), up to 4x.
+        let fewest = by_cell.iter().map(Vec::len).min().unwrap_or(0);
+        let most = by_cell.iter().map(Vec::len).max().unwrap_or(0);
+        assert!(
+            fewest > 100 && most < 4 * 400_000 / by_cell.len(),
+            "{fewest} to {most}"
+        );
         let mut always: Vec<u32> = grid.always.clone();
         always.sort_unstable();
         let around: Vec<u32> = (0..spheres.len() as u32)
