@@ -442,15 +442,22 @@ mod tests {
         // And one whose surface passes a ten-millionth of its radius beyond the centre.
         spheres.push((centre + direction() * (2.0 * (1.0 - 1e-7)), 2.0));
         // Directions on the cube's edges and corners, where two or three faces meet
-        // and a face coordinate is ±1 exactly, each with a sphere seen around it.
+        // and a face coordinate is ±1 exactly, each with a sphere seen around it, and a
+        // tiny one (4·10⁻⁵ rad) seen across the edge or corner, with directions to it
+        // from each side.
         let mut diagonals = Vec::new();
         for x in [-1.0, 0.0, 1.0] {
             for y in [-1.0, 0.0, 1.0] {
                 for z in [-1.0, 0.0, 1.0] {
-                    let d = DVec3::new(x, y, z);
-                    if d.abs().element_sum() >= 2.0 {
+                    let d = DVec3::new(x, y, z).normalize();
+                    if x * x + y * y + z * z >= 2.0 {
+                        spheres.push((centre + d * 5.0, 0.5));
+                        spheres.push((centre + d * 5.0, 2e-4));
+                        let (e1, e2) = d.any_orthonormal_pair();
                         diagonals.push(d);
-                        spheres.push((centre + d.normalize() * 5.0, 0.5));
+                        for e in [e1, -e1, e2, -e2] {
+                            diagonals.push((d + e * 2e-5).normalize());
+                        }
                     }
                 }
             }
@@ -458,7 +465,7 @@ mod tests {
         let grid = DirGrid::build(centre, &spheres, n, None);
 
         let mut samples: Vec<DVec3> = (0..400_000).map(|_| direction()).collect();
-        samples.extend(diagonals.iter().map(|d| d.normalize()));
+        samples.extend(diagonals);
         let mut by_cell = vec![Vec::new(); 6 * (n * n) as usize];
         for &d in &samples {
             by_cell[grid.cell(d.as_vec3())].push(d);
