@@ -179,28 +179,20 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                     }
                     // The eye's query with its precomputed constants is the general
                     // query, to the bit.
-                    let (general, from_eye) = (
-                        set.closest_primary(&eye_grid, &q),
-                        set.closest_from_eye(&eye_grid, q.dir),
-                    );
+                    let key = |h: Option<Hit>| h.map(|h| (h.point, h.normal, h.entering));
                     prop_assert_eq!(
-                        general.map(|h| (h.point, h.normal, h.entering)),
-                        from_eye.map(|h| (h.point, h.normal, h.entering))
+                        key(set.closest_primary(&eye_grid, &q)),
+                        key(set.closest_from_eye(&eye_grid, q.dir))
                     );
                     // The pair's second ray, the other way, is the general query's too.
                     let back = Query { dir: -q.dir, ..q };
-                    prop_assert_eq!(
-                        set.closest(&back).map(|h| (h.point, h.normal, h.entering)),
-                        pair[1].map(|h| (h.point, h.normal, h.entering))
-                    );
+                    prop_assert_eq!(key(set.closest(&back)), key(pair[1]));
                     // The eye grid is no use to a ray from elsewhere: the primary query
                     // hands it to the general one.
                     let elsewhere = Query { origin: light, ..q };
                     prop_assert_eq!(
-                        set.closest(&elsewhere)
-                            .map(|h| (h.point, h.normal, h.entering)),
-                        set.closest_primary(&eye_grid, &elsewhere)
-                            .map(|h| (h.point, h.normal, h.entering))
+                        key(set.closest(&elsewhere)),
+                        key(set.closest_primary(&eye_grid, &elsewhere))
                     );
                     // A shadow ray from the hit towards the light, through grid and BVH.
                     let Some(hit) = set.closest(&q) else { continue };
