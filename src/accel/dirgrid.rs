@@ -406,7 +406,7 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
 mod tests {
     use glam::DVec3;
 
-    use super::{from_ordered_bits, ordered_bits, DirGrid};
+    use super::{face_rect, from_ordered_bits, only_face, ordered_bits, DirGrid, WIDEN};
 
     /// What a grid lists, against the spheres' geometry in `f64` and directions drawn at
     /// random (each placed in its cell by the queries' own [`DirGrid::cell`]): a sphere
@@ -527,6 +527,142 @@ mod tests {
         }
         println!("{entries} entries, the farthest {widest:.3} of a half-width outside");
         assert!(entries > 1500, "{entries} entries");
+    }
+
+    /// Boxes of every shape and place around the centre: a direction, a distance from
+    /// 0.01 to 100, half-extents per axis from 10⁻⁵ to 2 times the distance (some hold
+    /// the centre), as `(lo, hi)` relative to the centre.
+    fn random_boxes(seed: u64, count: usize) -> Vec<(DVec3, DVec3)> {
+        let mut rng = rand_mt::Mt64::new(seed);
+        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        (0..count)
+            .map(|_| {
+                let (z, phi) = (2.0 * unit() - 1.0, std::f64::consts::TAU * unit());
+                let s = (1.0 - z * z).sqrt();
+                let dist = 10f64.powf(-2.0 + 4.0 * unit());
+                let centre = DVec3::new(s * phi.cos(), s * phi.sin(), z) * dist;
+                let mut half = || dist * 10f64.powf(-5.0 + 5.3 * unit());
+                let half = DVec3::new(half(), half(), half());
+                (centre - half, centre + half)
+            })
+            .collect()
+    }
+
+    /// A face's axis, its sign, and the two axes across it (u, v), as `face_rect` and
+    /// `from_face` number them.
+    fn face_axes(face: u32) -> (usize, f64, usize, usize) {
+        let axis = (face / 2) as usize;
+        let (b, c) = [(1, 2), (0, 2), (0, 1)][axis];
+        (axis, if face % 2 == 0 { 1.0 } else { -1.0 }, b, c)
+    }
+
+    fn corners(lo: DVec3, hi: DVec3) -> [DVec3; 8] {
+        std::array::from_fn(|k| {
+            DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+    }
+
+    /// `only_face` names a face for every box whose coordinates across that face stay
+    /// below (1 − 3·`WIDEN`) times its every distance along the face's axis, and names
+    /// a face only for a box wholly inside that face's pyramid, whose every other
+    /// face's `face_rect` is then empty (the queries look at no other face for it).
+    #[test]
+    fn only_face_names_the_one_face_a_box_is_seen_in() {
+        let (mut inside, mut named, mut straddling) = (0, 0, 0);
+        for (lo, hi) in random_boxes(5, 200_000) {
+            let corners = corners(lo, hi);
+            let clearly_in = (0..6).find(|&face| {
+                let (a, s, b, c) = face_axes(face);
+                let near = corners
+                    .iter()
+                    .map(|p| s * p[a])
+                    .fold(f64::INFINITY, f64::min);
+                let across = corners
+                    .iter()
+                    .map(|p| p[b].abs().max(p[c].abs()))
+                    .fold(0.0, f64::max);
+                near > 0.0 && across < near * (1.0 - 3.0 * WIDEN)
+            });
+            let got = only_face(lo, hi);
+            if let Some(face) = clearly_in {
+                inside += 1;
+                assert_eq!(got, Some(face), "box {lo} {hi}");
+            }
+            let Some(face) = got else {
+                straddling += usize::from(clearly_in.is_none());
+                continue;
+            };
+            named += 1;
+            let (a, s, b, c) = face_axes(face);
+            for p in corners {
+                assert!(
+                    s * p[a] > 0.0 && p[b].abs().max(p[c].abs()) < s * p[a],
+                    "box {lo} {hi}: corner {p} not in face {face}"
+                );
+            }
+            for other in (0..6).filter(|&g| g != face) {
+                assert_eq!(
+                    face_rect(other, lo, hi, 8),
+                    None,
+                    "box {lo} {hi}, face {other}"
+                );
+            }
+        }
+        println!("{inside} boxes clearly inside a face, {named} named, {straddling} not");
+        assert!(
+            inside > 20_000 && straddling > 20_000,
+            "{inside} {straddling}"
+        );
+    }
+
+    /// `face_rect` covers the cell of every direction in which a box is seen on that
+    /// face (its corners and 32 random points of it), and is `None` for a face that
+    /// the box lies wholly behind, or wholly beyond one edge of (by 1%, a plane through
+    /// the centre that every corner is past).
+    #[test]
+    fn face_rect_covers_the_cells_a_box_is_seen_in_and_no_face_it_is_not() {
+        let n = 8u32;
+        let mut rng = rand_mt::Mt64::new(6);
+        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let (mut covered, mut behind, mut beyond) = (0, 0, 0);
+        for (lo, hi) in random_boxes(7, 20_000) {
+            let corners = corners(lo, hi);
+            let mut points = corners.to_vec();
+            points.extend((0..32).map(|_| lo + (hi - lo) * DVec3::new(unit(), unit(), unit())));
+            for face in 0..6 {
+                let rect = face_rect(face, lo, hi, n);
+                let (a, s, b, c) = face_axes(face);
+                let cell = |x: f64| (((x + 1.0) * 0.5 * f64::from(n)) as u32).min(n - 1);
+                for p in &points {
+                    let w = s * p[a];
+                    if w > 0.0 && p[b].abs() <= w && p[c].abs() <= w {
+                        let (u, v) = (cell(p[b] / w), cell(p[c] / w));
+                        covered += 1;
+                        assert!(
+                            rect.is_some_and(|[u0, u1, v0, v1]| {
+                                (u0..=u1).contains(&u) && (v0..=v1).contains(&v)
+                            }),
+                            "box {lo} {hi}: {p} in face {face} cell ({u}, {v}), rect {rect:?}"
+                        );
+                    }
+                }
+                let all_behind = corners.iter().all(|p| s * p[a] <= 0.0);
+                let past_an_edge = [(b, 1.0), (b, -1.0), (c, 1.0), (c, -1.0)]
+                    .iter()
+                    .any(|&(x, sign)| corners.iter().all(|p| sign * p[x] > 1.01 * s * p[a]));
+                if all_behind || past_an_edge {
+                    behind += usize::from(all_behind);
+                    beyond += usize::from(past_an_edge && !all_behind);
+                    assert_eq!(rect, None, "box {lo} {hi}, face {face}");
+                }
+            }
+        }
+        println!("{covered} points seen, {behind} faces behind boxes, {beyond} beyond");
+        assert!(covered > 100_000 && behind > 10_000 && beyond > 10_000);
     }
 
     /// The sort keys order numbers as `total_cmp` does, negatives and zeros included.
