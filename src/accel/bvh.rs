@@ -151,8 +151,9 @@ impl Bvh {
         &self.items
     }
 
-    /// Calls `visit(slot)` for every item (`items()[slot]`) whose box overlaps the box
-    /// `[min, max]`.
+    /// Calls `visit(slot)` for every item (`items()[slot]`) of every leaf whose box
+    /// overlaps the box `[min, max]`: each item whose own box overlaps it, and the
+    /// others of its leaf.
     pub(super) fn overlapping(&self, min: Vec3A, max: Vec3A, mut visit: impl FnMut(u32)) {
         if self.nodes.is_empty() {
             return;
@@ -786,6 +787,78 @@ mod tests {
                 "n = {n}"
             );
         }
+    }
+
+    /// `overlapping` calls back with exactly the items of the leaves whose boxes (the
+    /// union of their items' boxes, computed here) overlap the query box, touching
+    /// included, each once: so every item whose own box overlaps it, checked against
+    /// every box. A tree of no items has none.
+    #[test]
+    fn overlapping_lists_the_leaves_whose_boxes_overlap() {
+        let mut rng = rand_mt::Mt64::new(3);
+        let mut unit = move || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32;
+        let mut random_box = |spread: f32, size: f32| {
+            let c = Vec3A::new(unit(), unit(), unit()) * spread;
+            let h = Vec3A::new(unit(), unit(), unit()) * size;
+            Aabb {
+                min: c - h,
+                max: c + h,
+            }
+        };
+        let overlap = |a: &Aabb, b: &Aabb| a.min.cmple(b.max).all() && a.max.cmpge(b.min).all();
+        let boxes: Vec<Aabb> = (0..3000).map(|_| random_box(100.0, 3.0)).collect();
+        let bvh = Bvh::build(boxes.len(), |k| boxes[k]);
+        let leaves: Vec<(Aabb, std::ops::Range<usize>)> = bvh
+            .nodes
+            .iter()
+            .flat_map(|node| (0..WIDTH).map(move |lane| (node.child[lane], node.count[lane])))
+            .filter(|&(_, count)| count > 0)
+            .map(|(child, count)| {
+                let slots = child as usize..child as usize + usize::from(count);
+                let mut b = Aabb::EMPTY;
+                for &k in &bvh.items()[slots.clone()] {
+                    b.grow(&boxes[k as usize]);
+                }
+                (b, slots)
+            })
+            .collect();
+        let (mut own, mut leaf_mates) = (0, 0);
+        for q in 0..600 {
+            let query = random_box(100.0, if q % 3 == 0 { 0.5 } else { 8.0 });
+            let mut got = Vec::new();
+            bvh.overlapping(query.min, query.max, |slot| got.push(slot as usize));
+            got.sort_unstable();
+            let mut expected: Vec<usize> = leaves
+                .iter()
+                .filter(|(b, _)| overlap(b, &query))
+                .flat_map(|(_, slots)| slots.clone())
+                .collect();
+            expected.sort_unstable();
+            assert_eq!(got, expected, "query {q}");
+            for k in 0..boxes.len() {
+                if overlap(&boxes[k], &query) {
+                    own += 1;
+                    let slot = bvh.items().iter().position(|&i| i as usize == k);
+                    assert!(
+                        slot.is_some_and(|s| got.binary_search(&s).is_ok()),
+                        "query {q}: {k}"
+                    );
+                }
+            }
+            leaf_mates += got.len();
+        }
+        leaf_mates -= own;
+        println!("{own} overlapping boxes listed, {leaf_mates} leaf-mates with them");
+        assert!(own > 1000 && leaf_mates > 0, "{own} {leaf_mates}");
+
+        let empty = Bvh::build(0, |_| unreachable!());
+        let mut calls = 0;
+        empty.overlapping(Vec3A::splat(-1e30), Vec3A::splat(1e30), |_| calls += 1);
+        empty.traverse(Vec3::ZERO, Vec3::ONE, f32::INFINITY, |_, _| {
+            calls += 1;
+            None
+        });
+        assert_eq!((calls, empty.items().len()), (0, 0));
     }
 
     /// The walk visits boxes nearest first and skips those beyond the closest hit
