@@ -742,6 +742,12 @@ mod tests {
             // The union of the items' boxes below node `node`, each lane checked.
             fn union(bvh: &Bvh, boxes: &[Aabb], node: usize, seen: &mut [u32]) -> Aabb {
                 let nd = &bvh.nodes[node];
+                // A node holds `WIDTH` children, or only leaves (the collapse opens
+                // inner children while there is room).
+                let lanes = nd.used.count_ones() as usize;
+                let inner = (0..lanes).filter(|&l| nd.count[l] == 0).count();
+                assert!(lanes == WIDTH || inner == 0, "node {node}: {lanes} lanes");
+                assert_eq!(u32::from(nd.used), (1 << lanes) - 1, "node {node}");
                 let mut all = Aabb::EMPTY;
                 for lane in 0..WIDTH {
                     if nd.used & (1 << lane) == 0 {
@@ -1010,6 +1016,39 @@ mod tests {
             .filter(|&(i, &p)| visited[..i].iter().any(|&q| q > p + LARGEST_LEAF as f32))
             .count();
         assert_eq!(behind, 0, "{}", first(&visited));
+    }
+
+    /// Eight cubes in a row split into two leaves of four: a ray along the row finds
+    /// its hit in the near leaf and never visits the far one, from either end (the
+    /// near child is taken first whichever lane it is in).
+    #[test]
+    fn of_two_children_the_near_one_is_walked_first() {
+        let boxes: Vec<Aabb> = (0..8)
+            .map(|k| cube(Vec3A::new(2.0 * ((k * 5) % 8) as f32, 0.0, 0.0), 1.0))
+            .collect();
+        let bvh = Bvh::build(boxes.len(), |k| boxes[k]);
+        assert_eq!((bvh.nodes.len(), bvh.nodes[0].used), (1, 0b11));
+        for (o, d) in [(-10.0f32, 1.0f32), (30.0, -1.0)] {
+            let mut visited = Vec::new();
+            bvh.traverse(
+                Vec3::new(o, 0.5, 0.5),
+                Vec3::new(d, 0.0, 0.0).recip(),
+                f32::INFINITY,
+                |slot, _| {
+                    let b = boxes[bvh.items()[slot as usize] as usize];
+                    visited.push(b.min.x);
+                    // A hit where the ray enters the cube.
+                    Some(if d > 0.0 { b.min.x - o } else { o - b.max.x })
+                },
+            );
+            visited.sort_by(f32::total_cmp);
+            let near_leaf = if d > 0.0 {
+                [0.0, 2.0, 4.0, 6.0]
+            } else {
+                [8.0, 10.0, 12.0, 14.0]
+            };
+            assert_eq!(visited, near_leaf, "from {o}");
+        }
     }
 
     /// Boxes that share one centre (concentric spheres) cannot be split by position:
