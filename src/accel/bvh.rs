@@ -1051,6 +1051,84 @@ mod tests {
         }
     }
 
+    /// The tree is a good one by its own measure: over 20,000 boxes in 60 clusters of
+    /// different sizes and densities, the expected number of items a ray through the
+    /// root box tests (each leaf's half-area, of the union of its items' boxes computed
+    /// here, times its items, over the root's) is at most 0.2 of that of a tree split
+    /// at the median on the centres' widest axis, built here with the same leaf size;
+    /// and every leaf holds at most `MAX_LEAF` items (no two centres coincide).
+    #[test]
+    fn the_tree_beats_median_splits_by_the_surface_area_heuristic() {
+        let mut rng = rand_mt::Mt64::new(21);
+        let mut unit = move || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32;
+        let clusters: Vec<(Vec3A, f32, f32)> = (0..60)
+            .map(|_| {
+                let c = Vec3A::new(unit(), unit(), unit()) * 1000.0;
+                (
+                    c,
+                    1.0 + 100.0 * unit() * unit(),
+                    0.05 + 2.0 * unit() * unit(),
+                )
+            })
+            .collect();
+        let boxes: Vec<Aabb> = (0..20_000)
+            .map(|k| {
+                let (c, spread, size) = clusters[(k * k) % 60 % (1 + k % 60)];
+                let p = c + (Vec3A::new(unit(), unit(), unit()) - 0.5) * spread;
+                let h = Vec3A::new(unit(), unit(), unit()) * size + 0.01;
+                Aabb {
+                    min: p - h,
+                    max: p + h,
+                }
+            })
+            .collect();
+        let area = |b: &Aabb| {
+            let e = (b.max - b.min).as_dvec3();
+            e.x * e.y + e.y * e.z + e.z * e.x
+        };
+        let union = |items: &[u32]| {
+            let mut b = Aabb::EMPTY;
+            items.iter().for_each(|&k| b.grow(&boxes[k as usize]));
+            b
+        };
+        let bvh = Bvh::build(boxes.len(), |k| boxes[k]);
+        let mut tests = 0.0;
+        for node in &bvh.nodes {
+            for lane in 0..WIDTH {
+                let count = usize::from(node.count[lane]);
+                if count > 0 {
+                    let first = node.child[lane] as usize;
+                    assert!(count <= MAX_LEAF, "a leaf of {count}");
+                    tests += area(&union(&bvh.items()[first..first + count])) * count as f64;
+                }
+            }
+        }
+        fn median(items: &mut [u32], boxes: &[Aabb], leaf: &mut dyn FnMut(&[u32])) {
+            if items.len() <= MAX_LEAF {
+                return leaf(items);
+            }
+            let centre = |k: u32| boxes[k as usize].min + boxes[k as usize].max;
+            let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+            for &k in items.iter() {
+                (lo, hi) = (lo.min(centre(k)), hi.max(centre(k)));
+            }
+            let axis = (hi - lo).max_position();
+            items.sort_by(|&a, &b| centre(a)[axis].total_cmp(&centre(b)[axis]));
+            let (l, r) = items.split_at_mut(items.len() / 2);
+            median(l, boxes, leaf);
+            median(r, boxes, leaf);
+        }
+        let mut all: Vec<u32> = (0..boxes.len() as u32).collect();
+        let mut median_tests = 0.0;
+        median(&mut all, &boxes, &mut |items| {
+            median_tests += area(&union(items)) * items.len() as f64;
+        });
+        let root = area(&union(&all));
+        let (tests, median_tests) = (tests / root, median_tests / root);
+        println!("{tests:.3} items tested a ray, {median_tests:.3} with median splits");
+        assert!(tests <= 0.2 * median_tests, "{tests} {median_tests}");
+    }
+
     /// Boxes that share one centre (concentric spheres) cannot be split by position:
     /// they still land in leaves of at most `LARGEST_LEAF` (a leaf's count is a byte),
     /// and a ray through the centre meets every one of them exactly once.
