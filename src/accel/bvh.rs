@@ -1130,8 +1130,9 @@ mod tests {
     }
 
     /// Boxes that share one centre (concentric spheres) cannot be split by position:
-    /// they still land in leaves of at most `LARGEST_LEAF` (a leaf's count is a byte),
-    /// and a ray through the centre meets every one of them exactly once.
+    /// up to `LARGEST_LEAF` of them make one leaf; more still land in leaves of at most
+    /// `LARGEST_LEAF` (a leaf's count is a byte); and a ray through the centre meets
+    /// every one of them exactly once.
     #[test]
     fn boxes_of_one_centre_split_into_small_leaves_and_all_are_met() {
         for n in [1usize, 16, 17, 300, 1000] {
@@ -1147,6 +1148,14 @@ mod tests {
             let bvh = Bvh::build(boxes.len(), |k| boxes[k]);
             for node in &bvh.nodes {
                 assert!(node.count.iter().all(|&c| usize::from(c) <= LARGEST_LEAF));
+            }
+            // Up to `LARGEST_LEAF` of them, no split beats a leaf: one leaf holds all.
+            if n <= LARGEST_LEAF {
+                assert_eq!(bvh.nodes.len(), 1, "n = {n}");
+                assert_eq!(
+                    (bvh.nodes[0].used, usize::from(bvh.nodes[0].count[0])),
+                    (1, n)
+                );
             }
             let mut met = vec![0u32; n];
             let o = Vec3::new(-5000.0, 0.25, 0.5);
