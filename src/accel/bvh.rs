@@ -842,8 +842,8 @@ mod tests {
                 .collect();
             expected.sort_unstable();
             assert_eq!(got, expected, "query {q}");
-            for k in 0..boxes.len() {
-                if overlap(&boxes[k], &query) {
+            for (k, b) in boxes.iter().enumerate() {
+                if overlap(b, &query) {
                     own += 1;
                     let slot = bvh.items().iter().position(|&i| i as usize == k);
                     assert!(

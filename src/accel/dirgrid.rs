@@ -553,7 +553,7 @@ mod tests {
     fn face_axes(face: u32) -> (usize, f64, usize, usize) {
         let axis = (face / 2) as usize;
         let (b, c) = [(1, 2), (0, 2), (0, 1)][axis];
-        (axis, if face % 2 == 0 { 1.0 } else { -1.0 }, b, c)
+        (axis, if face.is_multiple_of(2) { 1.0 } else { -1.0 }, b, c)
     }
 
     fn corners(lo: DVec3, hi: DVec3) -> [DVec3; 8] {
