@@ -464,7 +464,7 @@ fn rows_in_one_cell_get_the_per_ray_hits() {
 fn rays_inside_a_sphere_meet_what_brute_force_meets() {
     // (rays, ambiguous, met another sphere)
     let counts = RefCell::new((0u64, 0u64, 0u64));
-    // Spheres in overlapping pairs and triples, at every scale.
+    // Spheres in overlapping pairs, triples and quadruples, at every scale.
     let cluster = (
         log_uniform(-3.0, 3.0),
         log_uniform(-1.0, 4.0),
@@ -476,6 +476,9 @@ fn rays_inside_a_sphere_meet_what_brute_force_meets() {
         for (r, d, u, others) in clusters {
             let c = u * d;
             spheres.push(Sphere::new(c, r));
+            // And one that overlaps it by a hair: 10⁻⁷ of the two radii.
+            let v = u.any_orthonormal_vector();
+            spheres.push(Sphere::new(c + v * (1.5 * r * (1.0 - 1e-7)), 0.5 * r));
             for (v, off, size) in others {
                 spheres.push(Sphere::new(c + v * (r * off), r * size));
             }
