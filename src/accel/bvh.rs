@@ -1054,9 +1054,10 @@ mod tests {
     /// The tree is a good one by its own measure: over 20,000 boxes in 60 clusters of
     /// different sizes and densities, the expected number of items a ray through the
     /// root box tests (each leaf's half-area, of the union of its items' boxes computed
-    /// here, times its items, over the root's) is at most 0.2 of that of a tree split
-    /// at the median on the centres' widest axis, built here with the same leaf size;
-    /// and every leaf holds at most `MAX_LEAF` items (no two centres coincide).
+    /// here, times its items, over the root's) is at most 0.105 of that of a tree split
+    /// at the median on the centres' widest axis, built here with the same leaf size
+    /// (0.098 is measured: a tree 7% worse than today's fails); and every leaf holds
+    /// at most `MAX_LEAF` items (no two centres coincide).
     #[test]
     fn the_tree_beats_median_splits_by_the_surface_area_heuristic() {
         let mut rng = rand_mt::Mt64::new(21);
@@ -1126,7 +1127,7 @@ mod tests {
         let root = area(&union(&all));
         let (tests, median_tests) = (tests / root, median_tests / root);
         println!("{tests:.3} items tested a ray, {median_tests:.3} with median splits");
-        assert!(tests <= 0.2 * median_tests, "{tests} {median_tests}");
+        assert!(tests <= 0.105 * median_tests, "{tests} {median_tests}");
     }
 
     /// Boxes that share one centre (concentric spheres) cannot be split by position:
