@@ -595,6 +595,24 @@ mod tests {
         }
     }
 
+    /// Each leaf of the tree: the union of its items' boxes (from `boxes`, not the
+    /// tree's own bounds) and its slots.
+    fn leaves_of(bvh: &Bvh, boxes: &[Aabb]) -> Vec<(Aabb, std::ops::Range<usize>)> {
+        bvh.nodes
+            .iter()
+            .flat_map(|node| (0..WIDTH).map(move |lane| (node.child[lane], node.count[lane])))
+            .filter(|&(_, count)| count > 0)
+            .map(|(child, count)| {
+                let slots = child as usize..child as usize + usize::from(count);
+                let mut b = Aabb::EMPTY;
+                for &k in &bvh.items()[slots.clone()] {
+                    b.grow(&boxes[k as usize]);
+                }
+                (b, slots)
+            })
+            .collect()
+    }
+
     /// Half the surface area (the SAH's measure of how often a ray meets a box), by
     /// hand: 1·2 + 2·3 + 3·1 for a 1×2×3 box; a flat box has its one face; an empty or
     /// point box none.
@@ -815,20 +833,7 @@ mod tests {
         let overlap = |a: &Aabb, b: &Aabb| a.min.cmple(b.max).all() && a.max.cmpge(b.min).all();
         let boxes: Vec<Aabb> = (0..3000).map(|_| random_box(100.0, 3.0)).collect();
         let bvh = Bvh::build(boxes.len(), |k| boxes[k]);
-        let leaves: Vec<(Aabb, std::ops::Range<usize>)> = bvh
-            .nodes
-            .iter()
-            .flat_map(|node| (0..WIDTH).map(move |lane| (node.child[lane], node.count[lane])))
-            .filter(|&(_, count)| count > 0)
-            .map(|(child, count)| {
-                let slots = child as usize..child as usize + usize::from(count);
-                let mut b = Aabb::EMPTY;
-                for &k in &bvh.items()[slots.clone()] {
-                    b.grow(&boxes[k as usize]);
-                }
-                (b, slots)
-            })
-            .collect();
+        let leaves = leaves_of(&bvh, &boxes);
         let (mut own, mut leaf_mates) = (0, 0);
         for q in 0..600 {
             let query = random_box(100.0, if q % 3 == 0 { 0.5 } else { 8.0 });
@@ -888,20 +893,7 @@ mod tests {
             })
             .collect();
         let bvh = Bvh::build(boxes.len(), |k| boxes[k]);
-        let leaves: Vec<(Aabb, std::ops::Range<usize>)> = bvh
-            .nodes
-            .iter()
-            .flat_map(|node| (0..WIDTH).map(move |lane| (node.child[lane], node.count[lane])))
-            .filter(|&(_, count)| count > 0)
-            .map(|(child, count)| {
-                let slots = child as usize..child as usize + usize::from(count);
-                let mut b = Aabb::EMPTY;
-                for &k in &bvh.items()[slots.clone()] {
-                    b.grow(&boxes[k as usize]);
-                }
-                (b, slots)
-            })
-            .collect();
+        let leaves = leaves_of(&bvh, &boxes);
         // How far inside the box the segment runs: its length inside, or, when it
         // misses, minus the gap between its exit and entry parameters.
         let inside = |b: &Aabb, o: DVec3, d: DVec3, t_max: f64| {
