@@ -108,6 +108,12 @@ fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
                         "r {r:e}, |c| {:e}: exit t {t} vs f64 {t_ref}: relative error {rel:e}",
                         c.length()
                     );
+                    // A light inside the ball, halfway to the far side: the segment
+                    // to it ends before it leaves the ball, which does not shadow it.
+                    s.shadow += 1;
+                    if set.shadow(&q, 0.5 * t_ref) < 1.0 {
+                        s.shadowed += 1;
+                    }
                 }
                 // A grazing line that misses at f64 precision: so does the fast path.
                 (None, None) if truth == Truth::QueryRay => {}
