@@ -1086,15 +1086,9 @@ mod tests {
         };
         let bvh = Bvh::build(boxes.len(), |k| boxes[k]);
         let mut tests = 0.0;
-        for node in &bvh.nodes {
-            for lane in 0..WIDTH {
-                let count = usize::from(node.count[lane]);
-                if count > 0 {
-                    let first = node.child[lane] as usize;
-                    assert!(count <= MAX_LEAF, "a leaf of {count}");
-                    tests += area(&union(&bvh.items()[first..first + count])) * count as f64;
-                }
-            }
+        for (b, slots) in leaves_of(&bvh, &boxes) {
+            assert!(slots.len() <= MAX_LEAF, "a leaf of {}", slots.len());
+            tests += area(&b) * slots.len() as f64;
         }
         fn median(items: &mut [u32], boxes: &[Aabb], leaf: &mut dyn FnMut(&[u32])) {
             if items.len() <= MAX_LEAF {
