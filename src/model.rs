@@ -218,4 +218,19 @@ impl Side {
             Side::Outward
         }
     }
+
+    /// The side of a shadow ray that leaves its sphere on the `inside` side or not,
+    /// towards a light that the closed ball holds or not. A segment between two points
+    /// of a convex ball stays in it, so a shadow ray to a light the ball holds meets
+    /// its sphere no more, like an outward ray. Deciding by the light's position keeps
+    /// a light on the sphere from being shadowed by rounding: there the far root and
+    /// the light's distance agree only up to a few ulps.
+    pub fn towards_light(inside: bool, holds_light: impl FnOnce() -> bool) -> Side {
+        Side::inside(inside && !holds_light())
+    }
+}
+
+/// Whether the closed ball of centre `c` and radius `r` holds the point `p`.
+pub fn ball_holds(c: DVec3, r: f64, p: DVec3) -> bool {
+    (p - c).length_squared() <= r * r
 }

@@ -1102,6 +1102,48 @@ radius = 1
     assert_pixel(&render_both(&toml), 0, 0, DVec3::new(1.0, 0.5, 0.25));
 }
 
+/// A light on the surface of the ball the shading point is inside of: the shadow
+/// segment runs inside the ball (it is convex) to its end at the light and crosses
+/// nothing, s = 1. The camera at the origin sits on a ball of radius r centred at
+/// (0, 0, −r) and sees its far wall at p = (0, 0, −2r), seen normal (0, 0, 1), so
+/// the colour is kd ⊙ I · L.z. The lights lie exactly on their spheres in binary:
+/// Pythagorean triples scaled by powers of 2, 576 of them. There the segment's far
+/// root and the light's distance agree up to a few ulps; decided by the root, the
+/// ball shadowed the light, s = (1 + L·n)/2, in 96 of them in each tracer.
+#[test]
+fn a_light_on_the_ball_the_point_is_inside_of_is_not_shadowed_by_it() {
+    let kd = DVec3::new(1.0, 0.5, 0.25);
+    let triples = [
+        (1.0, 0.0, 1.0),
+        (3.0, 4.0, 5.0),
+        (5.0, 12.0, 13.0),
+        (8.0, 15.0, 17.0),
+    ];
+    let triples = triples
+        .into_iter()
+        .chain([(7.0, 24.0, 25.0), (20.0, 21.0, 29.0)]);
+    let mut lights = 0;
+    for (a, b, c) in triples {
+        for scale in (-4..8).map(|k| 2f64.powi(k)) {
+            let (r, centre) = (c * scale, DVec3::new(0.0, 0.0, -c * scale));
+            for (across, along) in [(a, b), (b, a), (-a, b), (-b, a)] {
+                for axis in [DVec3::X, DVec3::Y] {
+                    let light = centre + (axis * across + DVec3::Z * along) * scale;
+                    assert_eq!((light - centre).length_squared(), r * r, "on the sphere");
+                    let toml = one_pixel(&format!(
+                        "[[light]]\nposition = [{}, {}, {}]\n\n[[sphere]]\ncenter = [0, 0, {}]\nradius = {r}\ncolor = [1.0, 0.5, 0.25]\n",
+                        light.x, light.y, light.z, centre.z
+                    ));
+                    let to_light = (light - centre * 2.0).normalize();
+                    assert_pixel(&render_both(&toml), 0, 0, kd * to_light.z);
+                    lights += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(lights, 576);
+}
+
 /// A hit at the world's origin is shadowed like any other. The camera at (0, 0, 1)
 /// sees the ball at (0, 0, −1) head-on at p = (0, 0, 0), normal (0, 0, 1); the light
 /// at (10, 0, 10) gives n·L = 1/√2, and the ball at (5, 0, 5) sits on the segment's

@@ -301,6 +301,11 @@ impl Spheres {
         self.eye_point_grid(DirGrid::build(eye, &list, eye_resolution(list.len()), view))
     }
 
+    /// Whether sphere `k`'s closed ball holds the point `p` ([`crate::model::ball_holds`]).
+    pub(crate) fn holds(&self, k: u32, p: DVec3) -> bool {
+        crate::model::ball_holds(self.center[k as usize], self.radius[k as usize], p)
+    }
+
     pub(crate) fn len(&self) -> usize {
         self.center.len()
     }

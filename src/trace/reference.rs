@@ -357,7 +357,15 @@ impl<'a> ReferenceTracer<'a> {
                 let cos = nf.dot(l);
                 if cos > 0.0 {
                     counts.shadow += 1;
-                    let (shadow, occluder) = self.shadow(&spawn(l, !front), dist);
+                    let side = Side::towards_light(!front, || {
+                        model::ball_holds(s.center, s.radius, light.position)
+                    });
+                    let from = Ray {
+                        origin: hit.point,
+                        dir: l,
+                        from: Some((hit.sphere, side)),
+                    };
+                    let (shadow, occluder) = self.shadow(&from, dist);
                     let term = model::diffuse(s.color, light.intensity, cos, shadow);
                     rec.shadow(index, occluder, shadow, term, local_mix);
                     local += term;
