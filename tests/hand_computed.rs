@@ -1144,6 +1144,72 @@ fn a_light_on_the_ball_the_point_is_inside_of_is_not_shadowed_by_it() {
     assert_eq!(lights, 576);
 }
 
+/// A light on the surface of a ball that the shadow segment arrives at from outside:
+/// the segment meets the ball first at its open end, the light, and crosses nothing:
+/// s = 1. The diffuse ball at (0, 0, −3) is seen head-on at p = (0, 0, −2), normal
+/// (0, 0, 1), so the colour is kd ⊙ I · L.z. Each light P has balls beyond it, centred
+/// at P + u·2ᵏ for Pythagorean vectors u (|u| = c, radius c·2ᵏ), so that P lies
+/// exactly on each in binary, and the segment arrives from outside ((c − P)·L > 0);
+/// balls that come near the camera's ray or hold p are left out: 1,735 lights. There
+/// the near root and the light's distance agree up to rounding; decided by the root,
+/// the ball shadowed the light in 375 of them in the fast tracer and 224 in the
+/// reference.
+#[test]
+fn a_light_on_a_ball_the_segment_arrives_at_is_not_shadowed_by_it() {
+    let kd = DVec3::new(1.0, 0.5, 0.25);
+    let p = DVec3::new(0.0, 0.0, -2.0);
+    let triples = [(3.0, 4.0, 5.0), (5.0, 12.0, 13.0), (8.0, 15.0, 17.0)];
+    let towards = [
+        (1.0, 0.0, 2.0),
+        (2.0, 0.0, 1.0),
+        (0.0, 0.0, 3.0),
+        (-1.0, 0.0, 1.0),
+    ];
+    let towards = towards
+        .into_iter()
+        .chain([(0.0, -2.0, 1.0), (4.0, 4.0, 2.0)]);
+    let mut lights = 0;
+    for light in towards.map(|(x, y, z)| p + DVec3::new(x, y, z)) {
+        let l = (light - p).normalize();
+        for (a, b, c) in triples
+            .into_iter()
+            .chain([(7.0, 24.0, 25.0), (20.0, 21.0, 29.0)])
+        {
+            for scale in (-4..8).map(|k| 2f64.powi(k)) {
+                for u in across_two_axes(a, b) {
+                    let (centre, r) = (light + u * scale, c * scale);
+                    // Clear of the camera's ray, the −z axis, and of p.
+                    let clear = centre.truncate().length() > r + 1e-3;
+                    if (centre - light).dot(l) <= 0.0 || !clear || (centre - p).length() <= r {
+                        continue;
+                    }
+                    assert_eq!((light - centre).length_squared(), r * r, "on the sphere");
+                    let toml = one_pixel(&format!(
+                        "[[light]]\nposition = [{}, {}, {}]\n\n[[sphere]]\ncenter = [0, 0, -3]\nradius = 1\ncolor = [1.0, 0.5, 0.25]\n\n[[sphere]]\ncenter = [{}, {}, {}]\nradius = {r}\n",
+                        light.x, light.y, light.z, centre.x, centre.y, centre.z
+                    ));
+                    assert_pixel(&render_both(&toml), 0, 0, kd * l.z);
+                    lights += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(lights, 1735);
+}
+
+/// The 24 vectors with coordinates ±a and ±b on two axes and 0 on the third.
+fn across_two_axes(a: f64, b: f64) -> Vec<DVec3> {
+    let mut out = Vec::new();
+    for (i, j) in [(0, 1), (1, 0), (0, 2), (2, 0), (1, 2), (2, 1)] {
+        for (sa, sb) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            let mut u = [0.0; 3];
+            (u[i], u[j]) = (sa * a, sb * b);
+            out.push(DVec3::from_array(u));
+        }
+    }
+    out
+}
+
 /// A hit at the world's origin is shadowed like any other. The camera at (0, 0, 1)
 /// sees the ball at (0, 0, −1) head-on at p = (0, 0, 0), normal (0, 0, 1); the light
 /// at (10, 0, 10) gives n·L = 1/√2, and the ball at (5, 0, 5) sits on the segment's

@@ -301,11 +301,6 @@ impl Spheres {
         self.eye_point_grid(DirGrid::build(eye, &list, eye_resolution(list.len()), view))
     }
 
-    /// Whether sphere `k`'s closed ball holds the point `p` ([`crate::model::ball_holds`]).
-    pub(crate) fn holds(&self, k: u32, p: DVec3) -> bool {
-        crate::model::ball_holds(self.center[k as usize], self.radius[k as usize], p)
-    }
-
     pub(crate) fn len(&self) -> usize {
         self.center.len()
     }
@@ -472,20 +467,32 @@ impl Spheres {
         list.into_boxed_slice()
     }
 
+    /// Sphere `k`'s outward normal where the shadow segment of length `dist` first
+    /// crosses it, if it does before its end at the light at `light`
+    /// ([`crate::model::crosses_before_light`]).
+    #[inline(always)]
+    fn occluder_normal(&self, k: usize, ray: &Ray, dist: f64, light: DVec3) -> Option<DVec3> {
+        let (t, entering, n_k) = self.crossing(k, ray, dist)?;
+        let power = || crate::model::power(self.center[k], self.radius[k], light);
+        crate::model::crosses_before_light(t, dist, entering, power).then_some(n_k)
+    }
+
     /// Lowers `factor` by sphere `k`'s occlusion of the shadow segment.
     #[inline(always)]
-    fn occlude(&self, k: u32, ray: &Ray, dist: f64, factor: &mut f32) {
+    fn occlude(&self, k: u32, ray: &Ray, dist: f64, light: DVec3, factor: &mut f32) {
         let k = k as usize;
         if ray.from == Some((k as u32, Side::Outward)) || !self.may_cross(k, ray, round_up(dist)) {
             return;
         }
-        if let Some((_, _, n_k)) = self.crossing(k, ray, dist) {
+        if let Some(n_k) = self.occluder_normal(k, ray, dist, light) {
             *factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
         }
     }
 
-    /// The shadow factor along the segment of length `dist` (step 4 of the model).
-    pub(crate) fn shadow(&self, q: &Query, dist: f64) -> f32 {
+    /// The shadow factor along the segment of length `dist` to the light at `light`
+    /// (step 4 of the model), through the hierarchy.
+    #[cfg(test)]
+    pub(crate) fn shadow(&self, q: &Query, dist: f64, light: DVec3) -> f32 {
         let ray = Ray::new(q);
         let mut factor = 1.0f32;
         self.bvh.traverse(
@@ -496,7 +503,7 @@ impl Spheres {
                 let s = &self.leaf[slot as usize];
                 let own_outward = ray.from == Some((s.k, Side::Outward));
                 if !own_outward && may_cross(s.exact.center, s.quick_radius, &ray, t_max) {
-                    if let Some((_, _, n_k)) = self.crossing(s.k as usize, &ray, dist) {
+                    if let Some(n_k) = self.occluder_normal(s.k as usize, &ray, dist, light) {
                         factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
                     }
                 }

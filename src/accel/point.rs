@@ -350,11 +350,10 @@ impl Spheres {
             .is_some_and(|run| run.sees_nothing())
     }
 
-    /// The shadow factor along the segment of length `dist` towards light `light`.
+    /// The shadow factor along the segment of length `dist` towards light `light`,
+    /// through the light's grid.
     pub(crate) fn shadow_to_light(&self, q: &Query, dist: f64, light: usize) -> f32 {
-        let Some(lg) = self.lights.get(light) else {
-            return self.shadow(q, dist);
-        };
+        let lg = &self.lights[light];
         let start = ShadowStart::new(lg, q, dist);
         self.shadow_from_start(lg, &start)
     }
@@ -371,9 +370,7 @@ impl Spheres {
         b: (&Query, f64),
         light: usize,
     ) -> [f32; 2] {
-        let Some(lg) = self.lights.get(light) else {
-            return [self.shadow(a.0, a.1), self.shadow(b.0, b.1)];
-        };
+        let lg = &self.lights[light];
         let (start_a, start_b) = (
             ShadowStart::new(lg, a.0, a.1),
             ShadowStart::new(lg, b.0, b.1),
@@ -386,10 +383,10 @@ impl Spheres {
 
     #[inline(always)]
     fn shadow_from_start(&self, lg: &PointGrid, start: &ShadowStart<'_>) -> f32 {
-        let (ray, dist) = (&start.ray, start.dist);
+        let (ray, dist, light) = (&start.ray, start.dist, lg.grid.centre);
         let mut factor = 1.0f32;
         for &k in &lg.grid.always {
-            self.occlude(k, ray, dist, &mut factor);
+            self.occlude(k, ray, dist, light, &mut factor);
         }
         for &(k, near) in start.candidates {
             if f64::from(near) >= dist || factor <= 0.0 {
@@ -400,7 +397,7 @@ impl Spheres {
             {
                 continue;
             }
-            if let Some((_, _, n_k)) = self.crossing(k as usize, ray, dist) {
+            if let Some(n_k) = self.occluder_normal(k as usize, ray, dist, light) {
                 factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
             }
         }

@@ -223,15 +223,10 @@ impl FastTracer {
                 let cos = nf.dot(l);
                 if cos > 0.0 {
                     counts.shadow += 1;
-                    let spheres = &self.compiled.spheres;
-                    let side =
-                        Side::towards_light(!front, || spheres.holds(hit.sphere, light.position));
-                    let q = Query {
-                        origin: hit.point,
-                        dir: l,
-                        from: Some((hit.sphere, side)),
-                    };
-                    let shadow = spheres.shadow_to_light(&q, dist, index);
+                    let shadow =
+                        self.compiled
+                            .spheres
+                            .shadow_to_light(&spawn(l, !front), dist, index);
                     local += model::diffuse(m.color, light.intensity, cos, shadow);
                 }
             }
@@ -299,12 +294,10 @@ impl FastTracer {
             let to_light = light.position - h.point;
             let dist = to_light.length();
             let l = (to_light * (1.0 / dist)).as_vec3();
-            let side =
-                Side::towards_light(!h.entering, || c.spheres.holds(h.sphere, light.position));
             let q = Query {
                 origin: h.point,
                 dir: l,
-                from: Some((h.sphere, side)),
+                from: Some((h.sphere, Side::inside(!h.entering))),
             };
             (nf.dot(l), q, dist)
         };

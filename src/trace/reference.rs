@@ -275,14 +275,21 @@ impl<'a> ReferenceTracer<'a> {
         })
     }
 
-    /// The shadow factor `s` of step 4 along the segment from the hit to the light,
-    /// and the occluder that set it.
-    fn shadow(&self, from: &Ray, dist: f64) -> (f64, Option<usize>) {
+    /// The shadow factor `s` of step 4 along the segment from the hit to the light at
+    /// `light`, `dist` away, and the occluder that set it.
+    fn shadow(&self, from: &Ray, dist: f64, light: DVec3) -> (f64, Option<usize>) {
         let t_min = Self::t_min(from);
         let mut factor = 1.0f64;
         let mut occluder = None;
         for (k, s) in self.scene.spheres.iter().enumerate() {
-            if let Some((t, _)) = self.crossing(from, k, t_min, dist) {
+            let crossing = self
+                .crossing(from, k, t_min, dist)
+                .filter(|&(t, entering)| {
+                    model::crosses_before_light(t, dist, entering, || {
+                        model::power(s.center, s.radius, light)
+                    })
+                });
+            if let Some((t, _)) = crossing {
                 let n_k = (from.origin + from.dir * t - s.center) / s.radius;
                 let f = model::occluder_factor(from.dir, n_k);
                 if occluder.is_none() || f < factor {
@@ -357,15 +364,7 @@ impl<'a> ReferenceTracer<'a> {
                 let cos = nf.dot(l);
                 if cos > 0.0 {
                     counts.shadow += 1;
-                    let side = Side::towards_light(!front, || {
-                        model::ball_holds(s.center, s.radius, light.position)
-                    });
-                    let from = Ray {
-                        origin: hit.point,
-                        dir: l,
-                        from: Some((hit.sphere, side)),
-                    };
-                    let (shadow, occluder) = self.shadow(&from, dist);
+                    let (shadow, occluder) = self.shadow(&spawn(l, !front), dist, light.position);
                     let term = model::diffuse(s.color, light.intensity, cos, shadow);
                     rec.shadow(index, occluder, shadow, term, local_mix);
                     local += term;

@@ -206,7 +206,7 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                     c.shadowed += u64::from(want < 1.0);
                     let pair = set.shadow_to_light_pair((&sq, dist), (&sq, dist), 0);
                     for (name, got) in [
-                        ("shadow", set.shadow(&sq, dist)),
+                        ("shadow", set.shadow(&sq, dist, light)),
                         ("shadow_to_light", set.shadow_to_light(&sq, dist, 0)),
                         ("shadow_to_light_pair, first", pair[0]),
                         ("shadow_to_light_pair, second", pair[1]),

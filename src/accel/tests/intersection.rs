@@ -82,7 +82,12 @@ fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
             // A shadow ray toward a point outside, r·10^U(−3,3) away.
             let to = in_hemisphere(n, u, 1e-3) * (r * far);
             s.shadow += 1;
-            if set.shadow(&query(hit.point, to, Some((0, Side::Outward))), to.length()) < 1.0 {
+            if set.shadow(
+                &query(hit.point, to, Some((0, Side::Outward))),
+                to.length(),
+                hit.point + to,
+            ) < 1.0
+            {
                 s.shadowed += 1;
             }
             // Inward: the far side, at least 1e-2 from the tangent plane.
@@ -111,7 +116,7 @@ fn reintersection(truth: Truth, spheres: u32) -> Result<ReHits, String> {
                     // A light inside the ball, halfway to the far side: the segment
                     // to it ends before it leaves the ball, which does not shadow it.
                     s.shadow += 1;
-                    if set.shadow(&q, 0.5 * t_ref) < 1.0 {
+                    if set.shadow(&q, 0.5 * t_ref, o + dq * (0.5 * t_ref)) < 1.0 {
                         s.shadowed += 1;
                     }
                 }
