@@ -351,7 +351,7 @@ impl Spheres {
     }
 
     /// The shadow factor along the segment of length `dist` towards light `light`,
-    /// through the light's grid.
+    /// through the light's grid (the tracer builds one for every light).
     pub(crate) fn shadow_to_light(&self, q: &Query, dist: f64, light: usize) -> f32 {
         let lg = &self.lights[light];
         let start = ShadowStart::new(lg, q, dist);
