@@ -1197,6 +1197,43 @@ fn a_light_on_a_ball_the_segment_arrives_at_is_not_shadowed_by_it() {
     assert_eq!(lights, 1735);
 }
 
+/// A light a hair across a ball's surface from the segment, 2⁻²⁰ away, where the root
+/// and the light's distance still agree to 2⁻¹⁸, is shadowed by the ball: the light's
+/// side decides, as for a light on the surface, and here the segment does cross.
+/// - Arriving: the diffuse ball at (0, 0, −3) is seen head-on at p = (0, 0, −2); the
+///   light at (0, 0, 2 + 2⁻²⁰) is just inside the ball at (0, 0, 3), which the segment
+///   enters head-on at its pole: L·n = −1, s = 0. Black.
+/// - Leaving: the camera at the origin on the unit ball at (0, 0, −1) sees its far
+///   wall at p = (0, 0, −2); the light at (1 + 2⁻²⁰, 0, −1) is just outside. The
+///   segment leaves the ball at t = 2·L.z (p is on the sphere), X = p + t·L, with the
+///   normal n = X − c: s = (1 + L·n)/2 ≈ 0.854, and the colour kd ⊙ I · L.z · s.
+#[test]
+fn a_light_a_hair_beyond_a_ball_s_surface_is_shadowed_by_it() {
+    let hair = 2f64.powi(-20);
+    let arriving = one_pixel(&format!(
+        "[[light]]\nposition = [0, 0, {}]\n\n[[sphere]]\ncenter = [0, 0, -3]\nradius = 1\n\n[[sphere]]\ncenter = [0, 0, 3]\nradius = 1\n",
+        2.0 + hair
+    ));
+    assert_pixel(&render_both(&arriving), 0, 0, DVec3::ZERO);
+
+    let light = DVec3::new(1.0 + hair, 0.0, -1.0);
+    let leaving = one_pixel(&format!(
+        "[[light]]\nposition = [{}, 0, -1]\n\n[[sphere]]\ncenter = [0, 0, -1]\nradius = 1\ncolor = [1.0, 0.5, 0.25]\n",
+        light.x
+    ));
+    let p = DVec3::new(0.0, 0.0, -2.0);
+    let l = (light - p).normalize();
+    let n = p + l * (2.0 * l.z) - DVec3::new(0.0, 0.0, -1.0);
+    let s = (1.0 + l.dot(n)) / 2.0;
+    assert!((s - 0.854).abs() < 1e-3, "s = {s}");
+    assert_pixel(
+        &render_both(&leaving),
+        0,
+        0,
+        DVec3::new(1.0, 0.5, 0.25) * (l.z * s),
+    );
+}
+
 /// The 24 vectors with coordinates ±a and ±b on two axes and 0 on the third.
 fn across_two_axes(a: f64, b: f64) -> Vec<DVec3> {
     let mut out = Vec::new();
