@@ -1113,17 +1113,8 @@ radius = 1
 #[test]
 fn a_light_on_the_ball_the_point_is_inside_of_is_not_shadowed_by_it() {
     let kd = DVec3::new(1.0, 0.5, 0.25);
-    let triples = [
-        (1.0, 0.0, 1.0),
-        (3.0, 4.0, 5.0),
-        (5.0, 12.0, 13.0),
-        (8.0, 15.0, 17.0),
-    ];
-    let triples = triples
-        .into_iter()
-        .chain([(7.0, 24.0, 25.0), (20.0, 21.0, 29.0)]);
     let mut lights = 0;
-    for (a, b, c) in triples {
+    for (a, b, c) in [(1.0, 0.0, 1.0)].into_iter().chain(PYTHAGOREAN) {
         for scale in (-4..8).map(|k| 2f64.powi(k)) {
             let (r, centre) = (c * scale, DVec3::new(0.0, 0.0, -c * scale));
             for (across, along) in [(a, b), (b, a), (-a, b), (-b, a)] {
@@ -1158,7 +1149,6 @@ fn a_light_on_the_ball_the_point_is_inside_of_is_not_shadowed_by_it() {
 fn a_light_on_a_ball_the_segment_arrives_at_is_not_shadowed_by_it() {
     let kd = DVec3::new(1.0, 0.5, 0.25);
     let p = DVec3::new(0.0, 0.0, -2.0);
-    let triples = [(3.0, 4.0, 5.0), (5.0, 12.0, 13.0), (8.0, 15.0, 17.0)];
     let towards = [
         (1.0, 0.0, 2.0),
         (2.0, 0.0, 1.0),
@@ -1171,10 +1161,7 @@ fn a_light_on_a_ball_the_segment_arrives_at_is_not_shadowed_by_it() {
     let mut lights = 0;
     for light in towards.map(|(x, y, z)| p + DVec3::new(x, y, z)) {
         let l = (light - p).normalize();
-        for (a, b, c) in triples
-            .into_iter()
-            .chain([(7.0, 24.0, 25.0), (20.0, 21.0, 29.0)])
-        {
+        for (a, b, c) in PYTHAGOREAN {
             for scale in (-4..8).map(|k| 2f64.powi(k)) {
                 for u in across_two_axes(a, b) {
                     let (centre, r) = (light + u * scale, c * scale);
@@ -1233,6 +1220,15 @@ fn a_light_a_hair_beyond_a_ball_s_surface_is_shadowed_by_it() {
         DVec3::new(1.0, 0.5, 0.25) * (l.z * s),
     );
 }
+
+/// Triples a² + b² = c², exact in binary at every power-of-2 scale the tests use.
+const PYTHAGOREAN: [(f64, f64, f64); 5] = [
+    (3.0, 4.0, 5.0),
+    (5.0, 12.0, 13.0),
+    (8.0, 15.0, 17.0),
+    (7.0, 24.0, 25.0),
+    (20.0, 21.0, 29.0),
+];
 
 /// The 24 vectors with coordinates ±a and ±b on two axes and 0 on the third.
 fn across_two_axes(a: f64, b: f64) -> Vec<DVec3> {
