@@ -3,8 +3,9 @@
 #   1. the whole crate with its default features (the command line and the window);
 #   2. the core library alone (`--no-default-features`): its unit tests, the
 #      integration tests that need no binary, and the doc examples;
-#   3. the core's dependency tree holds none of the shells' crates;
-#   4. the Python package (python/), built by maturin into a virtual environment
+#   3. the core's documentation builds with no rustdoc warning (broken links);
+#   4. the core's dependency tree holds none of the shells' crates;
+#   5. the Python package (python/), built by maturin into a virtual environment
 #      made here (target/python-env), with its tests: the module against the command
 #      line, and `whitted.distributed` on a Dask cluster started on 127.0.0.1.
 set -euo pipefail
@@ -15,6 +16,9 @@ cargo test --release
 
 echo "== cargo test --release --no-default-features (the core library)"
 cargo test --release --no-default-features
+
+echo "== the core library's documentation (rustdoc, warnings are errors)"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --no-default-features --quiet
 
 echo "== the core's dependencies"
 shells="clap indicatif plotters nv-flip ctrlc winit pixels softbuffer anyhow"

@@ -2,7 +2,7 @@
 //!
 //! The data flows through the modules in this order:
 //! scene file → [`scene`] → [`settings`] and [`camera`] → [`trace`] (using the shared
-//! formulas of [`model`] and the ray–sphere roots of [`intersect`]) → [`render`] (the
+//! formulas of [`model`] and the ray–sphere roots of [`intersect`]) → [`render`](mod@render) (the
 //! frame buffer) → [`image_io`] (files), the window or a Python array.
 //!
 //! A scene carries the settings its file gives ([`Scene::image`]); options from a

@@ -190,7 +190,7 @@ impl Branches {
     }
 }
 
-/// The primary ray direction through film position `(s, t)` ∈ [0,1]²:
+/// The primary ray direction through film position `(s, t)` ∈ \[0, 1\]²:
 /// `normalize(LL + s·H + t·V − O)`, given `corner = LL − O` (computed once, in `f64`,
 /// so that a camera far from the world's origin loses nothing to cancellation).
 #[inline]
@@ -235,7 +235,7 @@ pub fn power(c: DVec3, r: f64, p: DVec3) -> f64 {
 
 /// Whether a shadow segment of length `dist` that meets a sphere at `t`, entering it
 /// or leaving it, crosses it before its end at the light (SPEC §2 step 4: the segment
-/// is open there). Away from the light the root decides. Within [`NEAR_LIGHT`] of it,
+/// is open there). Away from the light the root decides. Within `NEAR_LIGHT` of it,
 /// where the root and the light's distance agree only up to rounding (a light on the
 /// sphere), the light's side does, from its [`power`]: an entering segment crosses
 /// first iff the light is strictly inside, a leaving one iff strictly outside.

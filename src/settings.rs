@@ -27,7 +27,7 @@ pub enum Precision {
 
 /// Adaptive anti-aliasing: every pixel first gets `first` samples spread over it; only
 /// pixels whose first samples, or whose 4-neighbours' means, differ by `threshold` or
-/// more (largest colour component, linear values clamped to [0,1]) get the rest of the
+/// more (largest colour component, linear values clamped to \[0, 1\]) get the rest of the
 /// `spp` samples. `threshold = 0` refines every pixel, which is plain anti-aliasing
 /// bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq)]

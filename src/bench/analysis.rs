@@ -72,7 +72,7 @@ pub(crate) fn plain_row<'a>(rows: &'a [Row], scene: &str) -> Option<&'a Row> {
         .find(|r| r.scene == scene && r.setting.quality == plain())
 }
 
-/// The knee of a scene's front, "Kneedle" style: time and RMSE scaled to [0,1] between
+/// The knee of a scene's front, "Kneedle" style: time and RMSE scaled to \[0, 1\] between
 /// the plain setting (1 spp, depth 5, exact: the program's default) and the cheapest
 /// front point within 10% of the best RMSE of the fast tracer; the knee is the front
 /// point in between farthest below the straight line joining those two, where extra

@@ -8,7 +8,7 @@ use image::{DynamicImage, RgbImage};
 use crate::image_io::{to_byte, to_rgb32f};
 use crate::render::Frame;
 
-/// Errors of an image against the reference, both clamped to [0,1] as displayed.
+/// Errors of an image against the reference, both clamped to \[0, 1\] as displayed.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Errors {
     /// Root mean square error over pixels and channels, in 8-bit levels.

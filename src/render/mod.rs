@@ -2,10 +2,10 @@
 //! and the linear RGB buffer. Row 0 of every buffer here is the BOTTOM row of the
 //! image (`j = 0`, as in GLUT); the file writers and the window flip it, once.
 //!
-//! [`render`] takes a scene and resolved [`Settings`]; the submodules are its steps:
-//! [`bands`] (rows over threads), [`film`] (where samples land), [`adaptive`]
+//! [`render()`] takes a scene and resolved [`Settings`]; the submodules are its steps:
+//! `bands` (rows over threads), `film` (where samples land), `adaptive`
 //! (anti-aliasing where it matters), [`resolve`] (sums to finite pixel values) and
-//! [`progressive`] (sums kept between the passes of a progressive render).
+//! `progressive` (sums kept between the passes of a progressive render).
 
 mod adaptive;
 pub(crate) mod bands;

@@ -1,5 +1,5 @@
 //! The user's world: spheres, lights, sky, camera and image settings, in `f64` exactly
-//! as the scene file gave them. Loading ([`load`]) validates everything, so the
+//! as the scene file gave them. Loading (`load`) validates everything, so the
 //! renderers downstream may assume a scene is sane. This module never renders.
 
 mod animation;

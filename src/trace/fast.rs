@@ -1,5 +1,5 @@
 //! The fast tracer: the model of SPEC §2 in `f32` colours and directions, with the
-//! scene compiled once ([`crate::accel`]) and the intersection maths in `f64` where
+//! scene compiled once (`crate::accel`) and the intersection maths in `f64` where
 //! `f32` cannot hold.
 
 use std::sync::Arc;

@@ -1,5 +1,5 @@
 //! The model of SPEC §2 in two implementations that compute the same function:
-//! [`fast`], the `f32` tracer used for every image, and [`reference`], a plain `f64`
+//! [`fast`], the `f32` tracer used for every image, and [`reference`](mod@reference), a plain `f64`
 //! tracer written for clarity, against which the tests measure the fast one.
 
 pub mod fast;
@@ -35,7 +35,7 @@ impl RayCounts {
 
 /// Something that computes the linear RGB of one sample.
 pub trait SampleTracer: Sync {
-    /// The colour of the ray through film position `(s, t)` ∈ [0,1]² (`t` from the bottom).
+    /// The colour of the ray through film position `(s, t)` ∈ \[0, 1\]² (`t` from the bottom).
     /// Positions outside the film are outside the camera's view, which the fast
     /// tracer's eye grid is built for (it lists only the spheres reaching into it).
     fn sample(&self, s: f32, t: f32, counts: &mut RayCounts) -> Vec3;

@@ -34,7 +34,7 @@ pub enum Pass {
 }
 
 /// The preview factor for a `width`×`height` view that renders a preview within
-/// [`PREVIEW_SECONDS`] at `pixels_per_second` (measured on earlier one-sample passes);
+/// `PREVIEW_SECONDS` at `pixels_per_second` (measured on earlier one-sample passes);
 /// 1 (no preview) when the full view itself renders within that time: a preview would
 /// then only put a coarse picture in front of every frame of a drag.
 pub fn preview_factor(width: u32, height: u32, pixels_per_second: f64) -> u32 {
