@@ -45,15 +45,22 @@ impl<V: Vector> Roots<V> {
     }
 }
 
+/// The power of point `p` with respect to the sphere `(c, r)`: `|p − c|² − r²`,
+/// negative inside, 0 on the sphere, positive outside.
+#[inline]
+pub fn power<V: Vector>(p: V, c: V, r: V::R) -> V::R {
+    let f = p - c;
+    f.dot(f) - r * r
+}
+
 /// Both roots of the unit-direction ray `o + t·d` with the sphere `(c, r)`.
 #[inline]
 pub fn roots<V: Vector>(o: V, d: V, c: V, r: V::R) -> Option<Roots<V>> {
-    let f = o - c;
-    roots_from(f, f.dot(f) - r * r, d, r)
+    roots_from(o - c, power(o, c, r), d, r)
 }
 
-/// [`roots`] given `f = o − c` and `cterm = f·f − r²` (worked out once for rays that
-/// share an origin; the same values, so the same roots).
+/// [`roots`] given `f = o − c` and `cterm`, the origin's [`power`] (worked out once for
+/// rays that share an origin; the same values, so the same roots).
 #[inline]
 pub fn roots_from<V: Vector>(f: V, cterm: V::R, d: V, r: V::R) -> Option<Roots<V>> {
     let bp = -f.dot(d);

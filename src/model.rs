@@ -227,17 +227,11 @@ impl Side {
 /// holds it down to angles of about 2°.
 const NEAR_LIGHT: f64 = 1.0 / (1 << 18) as f64;
 
-/// The power of point `p` with respect to the sphere of centre `c` and radius `r`:
-/// `|p − c|² − r²`, negative inside, 0 on the sphere, positive outside.
-pub fn power(c: DVec3, r: f64, p: DVec3) -> f64 {
-    (p - c).length_squared() - r * r
-}
-
 /// Whether a shadow segment of length `dist` that meets a sphere at `t`, entering it
 /// or leaving it, crosses it before its end at the light (SPEC §2 step 4: the segment
 /// is open there). Away from the light the root decides. Within `NEAR_LIGHT` of it,
 /// where the root and the light's distance agree only up to rounding (a light on the
-/// sphere), the light's side does, from its [`power`]: an entering segment crosses
+/// sphere), the light's side does, from its [`crate::intersect::power`]: an entering segment crosses
 /// first iff the light is strictly inside, a leaving one iff strictly outside.
 #[inline]
 pub fn crosses_before_light(

@@ -17,7 +17,7 @@ use dirgrid::DirGrid;
 pub(crate) use point::{EyeGrid, PointGrid};
 pub(crate) use view::ViewPyramid;
 
-use crate::intersect::roots;
+use crate::intersect::{power, roots};
 use crate::model::Side;
 use crate::scene::Sphere;
 
@@ -473,8 +473,8 @@ impl Spheres {
     #[inline(always)]
     fn occluder_normal(&self, k: usize, ray: &Ray, dist: f64, light: DVec3) -> Option<DVec3> {
         let (t, entering, n_k) = self.crossing(k, ray, dist)?;
-        let power = || crate::model::power(self.center[k], self.radius[k], light);
-        crate::model::crosses_before_light(t, dist, entering, power).then_some(n_k)
+        let light_power = || power(light, self.center[k], self.radius[k]);
+        crate::model::crosses_before_light(t, dist, entering, light_power).then_some(n_k)
     }
 
     /// Lowers `factor` by sphere `k`'s occlusion of the shadow segment.

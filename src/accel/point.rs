@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::dirgrid::DirGrid;
 use super::{round_up, unit64, Best, Hit, Query, Ray, Spheres, QUICK_SLACK};
-use crate::intersect::roots_from;
+use crate::intersect::{power, roots_from};
 use crate::model::Side;
 
 /// A directional grid around a point (the camera origin or a light), with what the
@@ -195,15 +195,12 @@ impl Spheres {
             .quick
             .par_iter()
             .zip(self.center.par_iter().zip(&self.radius))
-            .map(|(&quick, (&c, &radius))| {
-                let f = eye - c;
-                EyeSphere {
-                    quick,
-                    f,
-                    cterm: f.dot(f) - radius * radius,
-                    radius,
-                    inv_radius: 1.0 / radius,
-                }
+            .map(|(&quick, (&c, &radius))| EyeSphere {
+                quick,
+                f: eye - c,
+                cterm: power(eye, c, radius),
+                radius,
+                inv_radius: 1.0 / radius,
             })
             .collect();
         PointGrid { exact, ..point }

@@ -8,7 +8,7 @@ use glam::{DVec3, Vec3};
 
 use super::{RayCounts, SampleTracer};
 use crate::camera::Camera;
-use crate::intersect::roots;
+use crate::intersect::{power, roots};
 use crate::model::{self, Branches, Side};
 
 use crate::scene::{Scene, Sphere};
@@ -286,7 +286,7 @@ impl<'a> ReferenceTracer<'a> {
                 .crossing(from, k, t_min, dist)
                 .filter(|&(t, entering)| {
                     model::crosses_before_light(t, dist, entering, || {
-                        model::power(s.center, s.radius, light)
+                        power(light, s.center, s.radius)
                     })
                 });
             if let Some((t, _)) = crossing {
