@@ -231,8 +231,9 @@ const NEAR_LIGHT: f64 = 1.0 / (1 << 18) as f64;
 /// or leaving it, crosses it before its end at the light (SPEC §2 step 4: the segment
 /// is open there). Away from the light the root decides. Within `NEAR_LIGHT` of it,
 /// where the root and the light's distance agree only up to rounding (a light on the
-/// sphere), the light's side does, from its [`crate::intersect::power`]: an entering segment crosses
-/// first iff the light is strictly inside, a leaving one iff strictly outside.
+/// sphere), the light's side does, from its power `|P − c|² − r²`: an entering
+/// segment crosses first iff the light is strictly inside, a leaving one iff strictly
+/// outside.
 #[inline]
 pub fn crosses_before_light(
     t: f64,
