@@ -9,6 +9,7 @@
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
+use super::round_down;
 use super::view::ViewPyramid;
 
 pub(super) struct DirGrid {
@@ -139,9 +140,7 @@ impl DirGrid {
             .map(|(k, &(c, r))| {
                 let dist = (c - centre).length();
                 let d = (dist - r) - 1e-6 * (dist + r + centre.abs().max_element());
-                let f = d as f32;
-                let near = if f64::from(f) > d { f.next_down() } else { f };
-                (u64::from(ordered_bits(near)) << 32) | k as u64
+                (u64::from(ordered_bits(round_down(d))) << 32) | k as u64
             })
             .collect();
         if keys.len() >= PARALLEL_SORT {

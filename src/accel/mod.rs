@@ -115,25 +115,9 @@ fn quick_sphere(c: DVec3, r: f64) -> Vec4 {
 fn sphere_box(c: DVec3, r: f64) -> Aabb {
     let widen = r * 1e-6 + 1e-6 * c.abs().max_element();
     let (lo, hi) = (c - DVec3::splat(r + widen), c + DVec3::splat(r + widen));
-    let down = |x: f64| {
-        let f = x as f32;
-        if f64::from(f) > x {
-            f.next_down()
-        } else {
-            f
-        }
-    };
-    let up = |x: f64| {
-        let f = x as f32;
-        if f64::from(f) < x {
-            f.next_up()
-        } else {
-            f
-        }
-    };
     Aabb {
-        min: Vec3A::new(down(lo.x), down(lo.y), down(lo.z)),
-        max: Vec3A::new(up(hi.x), up(hi.y), up(hi.z)),
+        min: Vec3A::new(round_down(lo.x), round_down(lo.y), round_down(lo.z)),
+        max: Vec3A::new(round_up(hi.x), round_up(hi.y), round_up(hi.z)),
     }
 }
 
@@ -643,17 +627,27 @@ fn list_radius(radius: &[f64]) -> f64 {
 /// `t` as an `f32` no smaller than it.
 #[inline(always)]
 fn round_up(t: f64) -> f32 {
+    // One step up is one more in the bits of a positive `f32` (of +0 the least
+    // subnormal, of `f32::MAX` infinity) and one less in those of a negative one (a
+    // cast to −0 never rounded down), chosen without a branch: whether the cast
+    // rounded the other way is a coin toss, and a mispredicted branch costs more
+    // than this.
     let f = t as f32;
-    if t >= 0.0 {
-        // The queries' distances: one step up is one more in the bits (of +0 the least
-        // subnormal, of f32::MAX infinity), added without a branch: whether the cast
-        // rounded down is a coin toss, and a mispredicted branch costs more than this.
-        f32::from_bits(f.to_bits() + u32::from(f64::from(f) < t))
-    } else if f64::from(f) < t {
-        f.next_up()
-    } else {
-        f
-    }
+    let step = u32::from(f64::from(f) < t);
+    let (bits, positive) = (f.to_bits(), f.is_sign_positive());
+    let stepped = if positive { bits + step } else { bits - step };
+    f32::from_bits(stepped)
+}
+
+/// `t` as an `f32` no larger than it ([`round_up`] mirrored: a cast to +0 never
+/// rounded up, and −0 one step down is the least negative subnormal).
+#[inline(always)]
+fn round_down(t: f64) -> f32 {
+    let f = t as f32;
+    let step = u32::from(f64::from(f) > t);
+    let (bits, positive) = (f.to_bits(), f.is_sign_positive());
+    let stepped = if positive { bits - step } else { bits + step };
+    f32::from_bits(stepped)
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use glam::{DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::dirgrid::DirGrid;
-use super::{round_up, unit64, Best, Hit, Query, Ray, Spheres, QUICK_SLACK};
+use super::{round_down, round_up, unit64, Best, Hit, Query, Ray, Spheres, QUICK_SLACK};
 use crate::intersect::{power, roots_from};
 use crate::model::Side;
 
@@ -128,13 +128,7 @@ impl PointQuick {
         let f = (point - centre).as_vec3();
         let (w, ff) = (f64::from(quick.w), f64::from(f.dot(f)));
         let slack = f64::from(QUICK_SLACK) * (w * w + ff);
-        let min_bp2 = ff - w * w - 2.0 * slack;
-        let rounded = min_bp2 as f32;
-        let min_bp2 = if f64::from(rounded) > min_bp2 {
-            rounded.next_down()
-        } else {
-            rounded
-        };
+        let min_bp2 = round_down(ff - w * w - 2.0 * slack);
         let ff = f.dot(f);
         let tail = QUICK_SLACK * (ff.sqrt() + quick.w);
         PointQuick {

@@ -13,7 +13,7 @@ use glam::DVec3;
 use proptest::strategy::Strategy;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
-use super::{list_radius, round_up, Query, WALK_INSIDE_FROM};
+use super::{list_radius, round_down, round_up, Query, WALK_INSIDE_FROM};
 use crate::model::Side;
 
 /// A proptest runner of `cases` cases with a fixed seed and no persisted failures.
@@ -119,34 +119,53 @@ fn sin_between(a: DVec3, b: DVec3) -> f64 {
     a.cross(b).length() / (a.length() * b.length())
 }
 
-#[test]
-fn round_up_is_the_least_f32_not_below() {
+/// Values on, beside and between `f32`s of every magnitude and sign, the zeros, the
+/// limits and beyond, the infinities and NaN.
+fn roundings_to_check() -> Vec<f64> {
     let mut values = vec![
         0.0,
         -0.0,
         1e-300,
+        -1e-300,
         f64::from(f32::MAX),
         f64::from(f32::MAX) * (1.0 + 1e-12),
-        1e300,
-        f64::INFINITY,
-        f64::NAN,
-        f64::NEG_INFINITY,
-        -1e-300,
-        -1.5,
         -f64::from(f32::MAX) * (1.0 + 1e-12),
+        1e300,
+        -1e300,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        -1.5,
     ];
-    // Values between, on and beside f32s of every magnitude.
-    for e in -140..=127 {
+    for e in -155..=129 {
         let f = 2f64.powi(e) * 1.2345;
-        let f32_near = f64::from(f as f32);
-        values.extend([f, -f, f32_near, f32_near.next_up(), f32_near.next_down()]);
+        for x in [f, -f] {
+            let f32_near = f64::from(x as f32);
+            values.extend([x, f32_near, f32_near.next_up(), f32_near.next_down()]);
+        }
     }
-    for t in values {
+    values
+}
+
+#[test]
+fn round_up_is_the_least_f32_not_below() {
+    for t in roundings_to_check() {
         let up = round_up(t);
         let f = t as f32;
         let want = if f64::from(f) < t { f.next_up() } else { f };
         assert_eq!(up.to_bits(), want.to_bits(), "t = {t:e}");
         assert!(t.is_nan() || f64::from(up) >= t, "t = {t:e}");
+    }
+}
+
+#[test]
+fn round_down_is_the_greatest_f32_not_above() {
+    for t in roundings_to_check() {
+        let down = round_down(t);
+        let f = t as f32;
+        let want = if f64::from(f) > t { f.next_down() } else { f };
+        assert_eq!(down.to_bits(), want.to_bits(), "t = {t:e}");
+        assert!(t.is_nan() || f64::from(down) <= t, "t = {t:e}");
     }
 }
 
