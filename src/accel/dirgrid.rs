@@ -30,28 +30,6 @@ pub(super) struct DirGrid {
 /// Spheres a unit of parallel work of the build: enough to outweigh its overhead.
 const SPHERES_PER_RUN: usize = 2048;
 
-/// Spheres from which the sort of the build runs on the pool's threads.
-const PARALLEL_SORT: usize = 1 << 16;
-
-/// The bits of `x` as an integer in the order of the numbers (`total_cmp`'s order).
-fn ordered_bits(x: f32) -> u32 {
-    let bits = x.to_bits();
-    if bits >> 31 == 1 {
-        !bits
-    } else {
-        bits | 1 << 31
-    }
-}
-
-/// The number whose [`ordered_bits`] are `bits`.
-fn from_ordered_bits(bits: u32) -> f32 {
-    f32::from_bits(if bits >> 31 == 1 {
-        bits & !(1 << 31)
-    } else {
-        !bits
-    })
-}
-
 /// What a run of spheres adds to a grid.
 #[derive(Default)]
 struct Run {
@@ -128,11 +106,12 @@ impl DirGrid {
     ) -> DirGrid {
         let faces = 6 * (n as usize) * (n as usize);
         // Visit spheres nearest first: the stable fill below then leaves every cell's
-        // list sorted, so closest-hit queries can stop early. Sorted as one `u64` key a
-        // sphere (its nearest distance from the centre, rounded down so that the early
-        // exit of queries stays conservative, in order-preserving bits; then the index,
-        // which settles ties): a plain integer sort, no lookups from the comparison.
-        let mut keys: Vec<u64> = spheres
+        // list sorted, so closest-hit queries can stop early. Each sphere's entry is its
+        // index and its nearest distance from the centre, rounded down so that the
+        // early exit of queries stays conservative; a radix sort by the distance (in
+        // `total_cmp`'s order, stable, so ties stay in index order) reads no memory but
+        // the entries and decides no coin toss per comparison.
+        let mut entries: Vec<(u32, f32)> = spheres
             .par_iter()
             .with_min_len(SPHERES_PER_RUN)
             .enumerate()
@@ -140,29 +119,19 @@ impl DirGrid {
             .map(|(k, &(c, r))| {
                 let dist = (c - centre).length();
                 let d = (dist - r) - 1e-6 * (dist + r + centre.abs().max_element());
-                (u64::from(ordered_bits(round_down(d))) << 32) | k as u64
+                (k as u32, round_down(d))
             })
             .collect();
-        if keys.len() >= PARALLEL_SORT {
-            keys.par_sort_unstable();
-        } else {
-            keys.sort_unstable();
-        }
-        // The spheres gathered in that order, each with its entry (index and nearest
-        // distance, both read back from its key): the walk over runs below then reads
-        // memory in order, and the gather's loads, independent of each other, overlap
-        // (a million spheres are 32 MB, and a load in sorted order misses the caches).
-        let sorted: Vec<((DVec3, f64), (u32, f32))> = keys
+        radsort::sort_by_key(&mut entries, |&(_, near)| near);
+        // The spheres gathered in that order, each with its entry: the walk over runs
+        // below then reads memory in order, and the gather's loads, independent of
+        // each other, overlap (a million spheres are 32 MB, and a load in sorted order
+        // misses the caches).
+        let sorted: Vec<((DVec3, f64), (u32, f32))> = entries
             .par_iter()
-            .map(|&key| {
-                let k = key as u32;
-                (
-                    spheres[k as usize],
-                    (k, from_ordered_bits((key >> 32) as u32)),
-                )
-            })
+            .map(|&(k, near)| (spheres[k as usize], (k, near)))
             .collect();
-        drop(keys);
+        drop(entries);
 
         let cones = CellCones::shared(n);
         // Each sphere's cells, in runs of spheres on rayon's threads; the runs come
@@ -405,7 +374,7 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
 mod tests {
     use glam::DVec3;
 
-    use super::{face_rect, from_ordered_bits, only_face, ordered_bits, DirGrid, WIDEN};
+    use super::{face_rect, only_face, DirGrid, WIDEN};
 
     /// What a grid lists, against the spheres' geometry in `f64` and directions drawn at
     /// random (each placed in its cell by the queries' own [`DirGrid::cell`]): a sphere
@@ -664,62 +633,30 @@ mod tests {
         assert!(covered > 100_000 && behind > 10_000 && beyond > 10_000);
     }
 
-    /// The sort keys order numbers as `total_cmp` does, negatives and zeros included.
+    /// Spheres at one nearest distance (copies of one sphere, and copies of another
+    /// exactly as far in another direction of the cell: 41 = |(0, 9, 40)|) are listed
+    /// in the order of their indices, after the nearer ones and before the farther
+    /// ones: the order is the distance, then the index, so the same scene always
+    /// gives the same lists.
     #[test]
-    fn ordered_bits_keep_the_order_of_the_numbers() {
-        let xs = [
-            f32::NEG_INFINITY,
-            -3.0e38,
-            -2.0,
-            -1e-40,
-            -0.0,
-            0.0,
-            1e-40,
-            0.5,
-            1.0,
-            7.25e30,
-            f32::INFINITY,
-        ];
-        for a in xs {
-            for b in xs {
-                assert_eq!(
-                    ordered_bits(a).cmp(&ordered_bits(b)),
-                    a.total_cmp(&b),
-                    "{a} {b}"
-                );
-            }
+    fn spheres_as_near_are_listed_in_index_order() {
+        let centre = DVec3::new(1.0, 2.0, 3.0);
+        let ahead = DVec3::new(0.0, 0.0, 41.0);
+        let mut spheres = Vec::new();
+        for k in 0..40 {
+            spheres.push(match k % 4 {
+                0 => (centre + ahead, 1.0),
+                1 => (centre + DVec3::new(0.0, 9.0, 40.0), 1.0),
+                2 => (centre + ahead * 2.0, 1.0),
+                _ => (centre + ahead * 0.5, 0.25),
+            });
         }
-    }
-
-    /// The keys give back the very bits they were made from (the grid's entries take
-    /// their distances from the sorted keys).
-    #[test]
-    fn ordered_bits_turn_back_into_the_same_number() {
-        let xs = [
-            f32::NEG_INFINITY,
-            f32::MIN,
-            -1.5,
-            -f32::MIN_POSITIVE / 4.0,
-            -0.0,
-            0.0,
-            f32::MIN_POSITIVE / 4.0,
-            1.0f32.next_down(),
-            3.25e7,
-            f32::MAX,
-            f32::INFINITY,
-            f32::NAN,
-            -f32::NAN,
-        ];
-        for x in xs {
-            assert_eq!(
-                from_ordered_bits(ordered_bits(x)).to_bits(),
-                x.to_bits(),
-                "{x}"
-            );
-        }
-        // Every bit pattern's key is distinct, so the inverse is the only one.
-        for bits in [0u32, 1, 0x7f80_0000, 0x8000_0000, 0xffff_ffff, 0x1234_5678] {
-            assert_eq!(ordered_bits(from_ordered_bits(bits)), bits, "{bits:#x}");
-        }
+        let grid = DirGrid::build(centre, &spheres, 4, None);
+        let list = grid.candidates(grid.cell(glam::Vec3::Z));
+        let ks: Vec<u32> = list.iter().map(|&(k, _)| k).collect();
+        let mut want: Vec<u32> = (0..40).filter(|k| k % 4 == 3).collect();
+        want.extend((0..40).filter(|k| k % 4 < 2));
+        want.extend((0..40).filter(|k| k % 4 == 2));
+        assert_eq!(ks, want);
     }
 }
