@@ -441,7 +441,7 @@ fn a_good_render_exits_0_with_a_closing_line() {
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let err = stderr(&out);
     let last = err.lines().last().unwrap_or_default();
-    // e.g. "rendered hw3 32x18 (1 spp, depth 5) in 0.001 s: 3541 rays, 1.3 Mrays/s"
+    // e.g. "rendered hw3 32x18 (1 spp, depth 5) in 0.0011 s: 3541 rays, 1.3 Mrays/s"
     assert!(
         last.starts_with("rendered hw3 32x18")
             && last.contains(" rays, ")

@@ -180,7 +180,7 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     }
     if !args.quiet {
         eprintln!(
-            "rendered {} {}x{} ({}) in {:.3} s: {} rays, {:.1} Mrays/s",
+            "rendered {} {}x{} ({}) in {:.4} s: {} rays, {:.1} Mrays/s",
             scene.name,
             area.width,
             area.height,
