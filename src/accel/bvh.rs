@@ -303,8 +303,10 @@ impl Bvh {
 
 /// Collapses the binary subtree at inner node `b` into wide nodes; returns its index.
 fn collapse(binary: &[Node], b: usize, out: &mut Vec<WideNode>) -> u32 {
-    // Open the largest inner child until there are `WIDTH` children.
-    let mut children = vec![b + 1, binary[b].index as usize];
+    // Open the largest inner child until there are `WIDTH` children (kept on the
+    // stack: a collapse makes a node for every seven binary ones).
+    let mut children: ArrayVec<usize, WIDTH> = ArrayVec::new();
+    children.extend([b + 1, binary[b].index as usize]);
     while children.len() < WIDTH {
         let open = children
             .iter()
