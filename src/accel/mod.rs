@@ -639,15 +639,11 @@ fn round_up(t: f64) -> f32 {
     f32::from_bits(stepped)
 }
 
-/// `t` as an `f32` no larger than it ([`round_up`] mirrored: a cast to +0 never
-/// rounded up, and −0 one step down is the least negative subnormal).
+/// `t` as an `f32` no larger than it: [`round_up`] mirrored (negation is exact in
+/// both widths).
 #[inline(always)]
 fn round_down(t: f64) -> f32 {
-    let f = t as f32;
-    let step = u32::from(f64::from(f) > t);
-    let (bits, positive) = (f.to_bits(), f.is_sign_positive());
-    let stepped = if positive { bits - step } else { bits + step };
-    f32::from_bits(stepped)
+    -round_up(-t)
 }
 
 #[cfg(test)]
