@@ -95,6 +95,7 @@ impl RenderArgs {
 }
 
 pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
+    super::keep_freed_blocks();
     let scene = load_scene(args.scene.as_deref())?;
     if animate::wanted(&args.animation, &scene, &args.output) {
         let opts = scene.settings().with(&args.overrides());
