@@ -499,6 +499,12 @@ impl Spheres {
     }
 }
 
+#[cfg(test)]
+thread_local! {
+    /// The exact tests run on this thread: the tests count the work the culling skips.
+    static EXACT_TESTS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
 /// [`Spheres::crossing_along`] of sphere `k`, given what the exact test reads of it.
 #[inline]
 fn crossing_of(
@@ -508,6 +514,8 @@ fn crossing_of(
     d: DVec3,
     t_max: f64,
 ) -> Option<(f64, bool, DVec3)> {
+    #[cfg(test)]
+    EXACT_TESTS.with(|n| n.set(n.get() + 1));
     let (o, t_min) = (ray.o64, ray.t_min);
     let (c, r, inv_r) = (sphere.center, sphere.radius, sphere.inv_radius);
     let own = ray

@@ -26,7 +26,7 @@ impl PointGrid {
     /// apply to a scene of `spheres` spheres: an eye grid (with the per-sphere records,
     /// even when there is no sphere), and the eye inside no sphere (else the general
     /// query runs).
-    fn eye_shortcut_applies(&self, spheres: usize) -> bool {
+    pub(super) fn eye_shortcut_applies(&self, spheres: usize) -> bool {
         self.grid.always.is_empty() && self.exact.len() == spheres
     }
 

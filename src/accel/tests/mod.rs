@@ -1,6 +1,7 @@
 //! Tests of the queries of [`Spheres`] against independent `f64` computations: the
 //! rounding of spawn points and distances ([`intersection`]), refraction through a ball
-//! ([`refraction`]) and the culling of the hierarchy and the grids ([`culling`]).
+//! ([`refraction`]), the culling of the hierarchy and the grids ([`culling`]) and the
+//! work it skips ([`work`]).
 //! Random cases come from proptest with log-uniform radii and distances and a fixed
 //! seed, so the printed figures reproduce.
 
@@ -8,6 +9,7 @@ mod culling;
 mod intersection;
 mod quick;
 mod refraction;
+mod work;
 
 use glam::DVec3;
 use proptest::strategy::Strategy;

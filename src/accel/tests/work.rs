@@ -1,0 +1,221 @@
+//! The work the culling exists to skip, on scenes built by hand where the exact tests
+//! a query needs are known: a sphere the ray cannot meet, or the one it leaves, costs
+//! no exact test; the quick tests, the overlap lists and the view pyramid keep no more
+//! than their rounding allowances; the structures a tracer builds are the ones its
+//! shortcuts read. Pixels cannot show any of this (a looser cull gives the same image,
+//! slower), so these tests are what holds it.
+
+use glam::DVec3;
+
+use super::query;
+use crate::accel::view::ViewPyramid;
+use crate::accel::{eye_resolution, grid_resolution, may_cross, Ray, Spheres, EXACT_TESTS};
+use crate::model::Side;
+use crate::scene::Sphere;
+
+/// The exact tests `work` runs on this thread, and its result.
+fn exact_tests<R>(work: impl FnOnce() -> R) -> (u64, R) {
+    let before = EXACT_TESTS.with(|n| n.get());
+    let result = work();
+    (EXACT_TESTS.with(|n| n.get()) - before, result)
+}
+
+/// Ball 0 at the origin, ball 1 ahead of it along +x, and three that no ray along the
+/// x axis meets: one beside it, one behind, one far off.
+fn row_of_balls() -> Vec<Sphere> {
+    vec![
+        Sphere::new(DVec3::ZERO, 1.0),
+        Sphere::new(DVec3::new(5.0, 0.0, 0.0), 1.0),
+        Sphere::new(DVec3::new(5.0, 4.0, 0.0), 1.0),
+        Sphere::new(DVec3::new(-5.0, 0.0, 0.0), 1.0),
+        Sphere::new(DVec3::new(3.0, -50.0, 20.0), 2.0),
+    ]
+}
+
+/// A ray leaving ball 0 along +x: only ball 1 is tested exactly. Ball 0 is the one it
+/// leaves (no crossing ahead of it), and the quick test rejects the others.
+#[test]
+fn a_ray_leaving_a_ball_tests_only_the_ball_ahead() {
+    let set = Spheres::new(&row_of_balls());
+    let q = query(
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::X,
+        Some((0, Side::Outward)),
+    );
+    let (tests, hit) = exact_tests(|| set.closest(&q));
+    let hit = hit.expect("ball 1 is ahead");
+    assert_eq!((hit.sphere, hit.point), (1, DVec3::new(4.0, 0.0, 0.0)));
+    assert_eq!(tests, 1);
+}
+
+/// A ray going into a big ball that overlaps a small one off its path: the ball's far
+/// side is the one exact test; the overlapping ball is on the ball's list, and its
+/// quick test rejects it.
+#[test]
+fn a_ray_inside_a_ball_tests_only_its_far_side() {
+    let set = Spheres::new(&[
+        Sphere::new(DVec3::ZERO, 10.0),
+        Sphere::new(DVec3::new(0.0, 9.0, 0.0), 2.0),
+    ]);
+    let q = query(
+        DVec3::new(-10.0, 0.0, 0.0),
+        DVec3::X,
+        Some((0, Side::Inward)),
+    );
+    let (tests, hit) = exact_tests(|| set.closest_inside(0, &q));
+    let hit = hit.expect("the far side of the ball the ray is in");
+    assert_eq!(
+        (hit.sphere, hit.point, hit.entering),
+        (0, DVec3::new(10.0, 0.0, 0.0), false)
+    );
+    assert_eq!(tests, 1);
+    assert_eq!(
+        set.inside[0].get().map(|list| &list[..]),
+        Some(&[1][..]),
+        "a ball of a small scene keeps its list of overlapping balls"
+    );
+}
+
+/// A shadow query from the top of ball 0 to a light inside it, leaving ball 0 by its
+/// outer side: a ray leaving a sphere's outside cannot cross it again, so ball 0 costs
+/// no exact test, although it holds the light (it is in the grid's `always` list,
+/// whose spheres the quick test cannot reject: the segment ends inside them); the
+/// other balls are off the segment.
+#[test]
+fn a_shadow_ray_tests_no_ball_it_cannot_cross() {
+    let light = DVec3::new(0.0, 0.5, 0.0);
+    let set = Spheres::new(&row_of_balls()).with_light_grids(&[light]);
+    let q = query(DVec3::Y, -DVec3::Y, Some((0, Side::Outward)));
+    let (tests, factor) = exact_tests(|| set.shadow_to_light(&q, 0.5, 0));
+    assert_eq!((tests, factor), (0, 1.0));
+}
+
+/// The tracer's build gives the eye's grid its per-sphere records (its shortcuts read
+/// them) and the lights' grids none (they would never be read).
+#[test]
+fn only_the_eye_s_grid_keeps_the_eye_s_records() {
+    let spheres = row_of_balls();
+    let lights = [DVec3::new(0.0, 30.0, 0.0), DVec3::new(20.0, 30.0, 5.0)];
+    let (set, eye) = Spheres::build_for_view(&spheres, &lights, DVec3::new(0.0, 0.0, 9.0), None);
+    assert!(eye.eye_shortcut_applies(spheres.len()));
+    assert_eq!(set.lights.len(), 2);
+    assert!(set
+        .lights
+        .iter()
+        .all(|light| !light.eye_shortcut_applies(spheres.len())));
+}
+
+/// The cells a face of the eye's and the lights' grids, as docs/speed.md gives them
+/// (the minima of sweeps over scene sizes).
+#[test]
+fn grids_are_as_fine_as_their_scene_s_size_asks() {
+    let eye = [
+        (0, 12),
+        (64, 12),
+        (65, 32),
+        (256, 32),
+        (257, 64),
+        (16_384, 64),
+        (16_385, 192),
+    ];
+    for (spheres, cells) in eye {
+        assert_eq!(eye_resolution(spheres), cells, "eye, {spheres} spheres");
+    }
+    let light = [(0, 128), (4_096, 128), (4_097, 256), (1 << 20, 256)];
+    for (spheres, cells) in light {
+        assert_eq!(grid_resolution(spheres), cells, "light, {spheres} spheres");
+    }
+}
+
+/// The quick test widens a sphere by `32u·|f|` (`u = 2⁻²⁴`, `f` the centre from the
+/// ray's origin) for the rounding of the line's distance, which errs by at most `13u·|f|`: a
+/// line passing `50u·|f|` outside the sphere is rejected however it rounds. Spheres of
+/// radius 10⁻³ to 10³, 20 to 10⁴ radii away, lines in every direction.
+#[test]
+fn the_quick_test_rejects_a_line_a_few_roundings_outside() {
+    let mut rng = rand_mt::Mt64::new(21);
+    let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+    let mut rejected = 0;
+    for _ in 0..20_000 {
+        let r = 10f64.powf(6.0 * unit() - 3.0);
+        let away = r * 10f64.powf(1.3 + 2.7 * unit());
+        let direction = |a: f64, b: f64| {
+            let z = 2.0 * a - 1.0;
+            let s = (1.0 - z * z).sqrt();
+            let phi = std::f64::consts::TAU * b;
+            DVec3::new(s * phi.cos(), s * phi.sin(), z)
+        };
+        let centre = direction(unit(), unit()) * away;
+        let d = direction(unit(), unit()).as_vec3().normalize();
+        let d64 = d.as_dvec3();
+        let across = d64.any_orthonormal_vector();
+        let w = f64::from(r as f32) * (1.0 + 1e-6);
+        // The origin on a line that passes `w + 50u·|f|` from the centre, the centre's
+        // foot halfway along the segment.
+        let gap = w + 50.0 * 2f64.powi(-24) * away;
+        let origin = centre + across * gap - d64 * away;
+        let ray = Ray::new(&query(origin, d64, None));
+        let f = (origin - centre).length();
+        assert!(
+            !may_cross(centre, w as f32, &ray, (2.0 * f) as f32),
+            "r {r:e}, |f| {f:e}, line {gap:e} from the centre"
+        );
+        rejected += 1;
+    }
+    assert_eq!(rejected, 20_000);
+}
+
+/// Sphere 1's list of the spheres overlapping it allows `10⁻⁶` of the radii and
+/// `10⁻⁹` of the centres' distances from the origin for rounding: a sphere apart by
+/// more than twice that is not on it, a sphere touching it is. Small spheres near the
+/// origin and large ones far from it.
+#[test]
+fn overlap_lists_keep_no_sphere_beyond_their_allowance() {
+    for (centre, r) in [
+        (DVec3::new(1e-3, 0.0, 0.0), 1e-4),
+        (DVec3::new(1e4, 0.0, 0.0), 1.0),
+    ] {
+        let allowance = 2e-6 * r + 2e-9 * 2.0 * centre.length();
+        let apart = |gap: f64| Sphere::new(centre + DVec3::new(0.0, 2.0 * r + gap, 0.0), r);
+        let set = Spheres::new(&[
+            apart(2.0 * allowance),
+            Sphere::new(centre, r),
+            apart(0.0),
+            apart(-0.5 * r),
+        ]);
+        assert_eq!(
+            &set.overlapping(1)[..],
+            &[2, 3],
+            "around {centre} radius {r}"
+        );
+    }
+}
+
+/// The eye's grid keeps a sphere unless it lies wholly outside a side of the view
+/// pyramid by more than `10⁻⁶` of its radius and `10⁻⁹` of its centre's distance: a
+/// sphere outside by twice that is dropped, one that touches the side is kept. Small
+/// spheres near the eye, and small and large ones far from it.
+#[test]
+fn the_view_pyramid_drops_a_sphere_just_beyond_its_allowance() {
+    // The film spans x and y in [−1, 1] at z = −1: the pyramid's right side leans out
+    // by the film's margin of 10⁻³.
+    let view = ViewPyramid::new(
+        DVec3::ZERO,
+        DVec3::new(-1.0, -1.0, -1.0),
+        DVec3::new(2.0, 0.0, 0.0),
+        DVec3::new(0.0, 2.0, 0.0),
+    )
+    .expect("a proper pyramid");
+    let edge = 1.0 + 2e-3;
+    let outward = DVec3::new(1.0, 0.0, edge).normalize();
+    for (depth, r) in [(1e-3, 1e-5), (1e4, 1.0), (1e4, 100.0)] {
+        let on_side = DVec3::new(edge * depth, 0.0, -depth);
+        let allowance = 2e-6 * r + 2e-9 * (on_side.abs().max_element() + r);
+        let at = |gap: f64| on_side + outward * (r + gap);
+        assert!(view.may_see(at(0.0), r), "touching, depth {depth}");
+        assert!(
+            !view.may_see(at(2.0 * allowance), r),
+            "beyond, depth {depth}"
+        );
+    }
+}
