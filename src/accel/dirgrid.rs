@@ -218,15 +218,23 @@ struct CellCones {
 }
 
 impl CellCones {
-    /// The cones for `n` cells per side, computed once per process.
+    /// The cones for `n` cells per side, computed once per process. The cache is not
+    /// held while they are worked out: that work runs on the pool, where a thread
+    /// waiting for it runs other jobs meanwhile, such as a build waiting for the cache.
+    /// (Two builds may then work out the same cones; the first kept is shared.)
     fn shared(n: u32) -> std::sync::Arc<CellCones> {
         static CACHE: std::sync::Mutex<Vec<std::sync::Arc<CellCones>>> =
             std::sync::Mutex::new(Vec::new());
-        let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(c) = cache.iter().find(|c| c.n == n) {
-            return c.clone();
+        let lock = || CACHE.lock().unwrap_or_else(|e| e.into_inner());
+        let cached = |cache: &[std::sync::Arc<CellCones>]| cache.iter().find(|c| c.n == n).cloned();
+        if let Some(cones) = cached(&lock()) {
+            return cones;
         }
         let cones = std::sync::Arc::new(CellCones::new(n));
+        let mut cache = lock();
+        if let Some(first) = cached(&cache) {
+            return first;
+        }
         cache.push(cones.clone());
         cones
     }
@@ -519,6 +527,37 @@ mod tests {
         }
         println!("{entries} entries, the farthest {widest:.3} of a half-width outside");
         assert!(entries > 1500, "{entries} entries");
+    }
+
+    /// Grids built at once by several renders sharing one pool (the tests do, as may
+    /// a program calling the library from several threads), each of a resolution not
+    /// built before, all finish: no thread holds the cones' cache while the cones are
+    /// worked out on the pool (a thread that waits for that work runs other jobs
+    /// meanwhile, and one of them may be a build waiting for the cache: for ever).
+    #[test]
+    fn grids_built_at_once_by_renders_sharing_a_pool_finish() {
+        let (done, finished) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .build()
+                .expect("a pool");
+            std::thread::scope(|scope| {
+                for _ in 0..4 {
+                    scope.spawn(|| {
+                        let spheres = [(DVec3::new(0.0, 0.0, 5.0), 1.0)];
+                        for n in 300..360 {
+                            let grid =
+                                pool.install(|| DirGrid::build(DVec3::ZERO, &spheres, n, None));
+                            assert!(grid.items.len() > 1, "the sphere is seen in several cells");
+                        }
+                    });
+                }
+            });
+            done.send(()).expect("the test waits for the builds");
+        });
+        let waited = finished.recv_timeout(std::time::Duration::from_secs(120));
+        assert!(waited.is_ok(), "the builds did not finish in 2 minutes");
     }
 
     /// Boxes of every shape and place around the centre: a direction, a distance from
