@@ -121,7 +121,14 @@ fn grids_are_as_fine_as_their_scene_s_size_asks() {
     for (spheres, cells) in eye {
         assert_eq!(eye_resolution(spheres), cells, "eye, {spheres} spheres");
     }
-    let light = [(0, 128), (4_096, 128), (4_097, 256), (1 << 20, 256)];
+    let light = [
+        (0, 64),
+        (64, 64),
+        (65, 128),
+        (4_096, 128),
+        (4_097, 256),
+        (1 << 20, 256),
+    ];
     for (spheres, cells) in light {
         assert_eq!(grid_resolution(spheres), cells, "light, {spheres} spheres");
     }
