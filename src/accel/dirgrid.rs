@@ -6,6 +6,8 @@
 //! Cells are filled conservatively (a sphere's bounding box, widened), so a query
 //! sees every sphere it could hit: the grid changes the work, never the answer.
 
+use std::sync::{Arc, Mutex};
+
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -222,15 +224,14 @@ impl CellCones {
     /// held while they are worked out: that work runs on the pool, where a thread
     /// waiting for it runs other jobs meanwhile, such as a build waiting for the cache.
     /// (Two builds may then work out the same cones; the first kept is shared.)
-    fn shared(n: u32) -> std::sync::Arc<CellCones> {
-        static CACHE: std::sync::Mutex<Vec<std::sync::Arc<CellCones>>> =
-            std::sync::Mutex::new(Vec::new());
+    fn shared(n: u32) -> Arc<CellCones> {
+        static CACHE: Mutex<Vec<Arc<CellCones>>> = Mutex::new(Vec::new());
         let lock = || CACHE.lock().unwrap_or_else(|e| e.into_inner());
-        let cached = |cache: &[std::sync::Arc<CellCones>]| cache.iter().find(|c| c.n == n).cloned();
+        let cached = |cache: &[Arc<CellCones>]| cache.iter().find(|c| c.n == n).cloned();
         if let Some(cones) = cached(&lock()) {
             return cones;
         }
-        let cones = std::sync::Arc::new(CellCones::new(n));
+        let cones = Arc::new(CellCones::new(n));
         let mut cache = lock();
         if let Some(first) = cached(&cache) {
             return first;

@@ -6,8 +6,9 @@
 //! slower), so these tests are what holds it.
 
 use glam::DVec3;
+use proptest::prop_assert;
 
-use super::query;
+use super::{log_uniform, query, runner, unit_vector};
 use crate::accel::view::ViewPyramid;
 use crate::accel::{eye_resolution, grid_resolution, may_cross, Ray, Spheres, EXACT_TESTS};
 use crate::model::Side;
@@ -140,36 +141,31 @@ fn grids_are_as_fine_as_their_scene_s_size_asks() {
 /// radius 10⁻³ to 10³, 20 to 10⁴ radii away, lines in every direction.
 #[test]
 fn the_quick_test_rejects_a_line_a_few_roundings_outside() {
-    let mut rng = rand_mt::Mt64::new(21);
-    let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-    let mut rejected = 0;
-    for _ in 0..20_000 {
-        let r = 10f64.powf(6.0 * unit() - 3.0);
-        let away = r * 10f64.powf(1.3 + 2.7 * unit());
-        let direction = |a: f64, b: f64| {
-            let z = 2.0 * a - 1.0;
-            let s = (1.0 - z * z).sqrt();
-            let phi = std::f64::consts::TAU * b;
-            DVec3::new(s * phi.cos(), s * phi.sin(), z)
-        };
-        let centre = direction(unit(), unit()) * away;
-        let d = direction(unit(), unit()).as_vec3().normalize();
-        let d64 = d.as_dvec3();
-        let across = d64.any_orthonormal_vector();
-        let w = f64::from(r as f32) * (1.0 + 1e-6);
-        // The origin on a line that passes `w + 50u·|f|` from the centre, the centre's
-        // foot halfway along the segment.
-        let gap = w + 50.0 * 2f64.powi(-24) * away;
-        let origin = centre + across * gap - d64 * away;
-        let ray = Ray::new(&query(origin, d64, None));
-        let f = (origin - centre).length();
-        assert!(
-            !may_cross(centre, w as f32, &ray, (2.0 * f) as f32),
-            "r {r:e}, |f| {f:e}, line {gap:e} from the centre"
-        );
-        rejected += 1;
-    }
-    assert_eq!(rejected, 20_000);
+    let cases = (
+        log_uniform(-3.0, 3.0),
+        log_uniform(1.3, 4.0),
+        unit_vector(),
+        unit_vector(),
+    );
+    runner(20_000)
+        .run(&cases, |(r, radii_away, centre_dir, dir)| {
+            let away = r * radii_away;
+            let centre = centre_dir * away;
+            let d = dir.as_vec3().normalize().as_dvec3();
+            let w = f64::from(r as f32) * (1.0 + 1e-6);
+            // The origin on a line that passes `w + 50u·|f|` from the centre, the
+            // centre's foot halfway along the segment.
+            let gap = w + 50.0 * 2f64.powi(-24) * away;
+            let origin = centre + d.any_orthonormal_vector() * gap - d * away;
+            let ray = Ray::new(&query(origin, d, None));
+            let f = (origin - centre).length();
+            prop_assert!(
+                !may_cross(centre, w as f32, &ray, (2.0 * f) as f32),
+                "r {r:e}, |f| {f:e}, line {gap:e} from the centre"
+            );
+            Ok(())
+        })
+        .unwrap();
 }
 
 /// Sphere 1's list of the spheres overlapping it allows `10⁻⁶` of the radii and
