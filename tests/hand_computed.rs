@@ -476,10 +476,12 @@ fn degenerate_cameras_are_refused_with_their_reason() {
         let checked = if want == NotFinite { Ok(()) } else { Err(want) };
         assert_eq!(spec.check(), checked, "{spec:?}");
     }
-    // Just inside each limit: accepted.
+    // Just inside each limit, or on it where the limit is strict: accepted.
     let z = [0.0, 0.0, -1.0];
     for spec in [
         look_at([0.0; 3], z, [1e-8, 0.0, 1.0], 60.0),
+        // |up × w| = 1e-9 exactly (√(x²) is x in binary floating point), not below it.
+        look_at([0.0; 3], z, [1e-9, 0.0, 1.0], 60.0),
         look_at([0.0; 3], z, y, 0.001),
         look_at([0.0; 3], z, y, 179.9),
         // |H × V| = 2e-7 > 2e-8: a sine of 1e-11.

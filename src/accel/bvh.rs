@@ -1029,6 +1029,33 @@ mod tests {
         assert!(met > 3000 && missed > 500_000, "{met} {missed}");
     }
 
+    /// The segment the walk covers is closed: the boxes it touches only at its ends,
+    /// ending exactly at `t = 0` or starting exactly at `t_max`, are visited (the
+    /// boxes beyond them, by the walk test above). Eight at each end and eight far
+    /// beyond, groups far enough apart to make leaves of their own.
+    #[test]
+    fn the_walk_visits_boxes_the_segment_touches_at_its_ends() {
+        let groups = [(-2.0, 0.0), (5.0, 6.0), (20.0, 21.0)];
+        let boxes: Vec<Aabb> = (0..24)
+            .map(|k| {
+                let (x0, x1) = groups[k / 8];
+                let y = (k % 8) as f32 * 0.25;
+                Aabb {
+                    min: Vec3A::new(x0, y - 2.0, -1.0),
+                    max: Vec3A::new(x1, y + 2.0, 1.0),
+                }
+            })
+            .collect();
+        let bvh = Bvh::build(boxes.len(), |k| boxes[k]);
+        let mut visited = vec![false; boxes.len()];
+        bvh.traverse(Vec3::ZERO, Vec3::X.recip(), 5.0, |slot, _| {
+            visited[bvh.items()[slot as usize] as usize] = true;
+            None
+        });
+        let expected: Vec<bool> = (0..24).map(|k| k < 16).collect();
+        assert_eq!(visited, expected);
+    }
+
     /// The walk visits boxes nearest first and skips those beyond the closest hit
     /// found: a ray along a row of 10,000 boxes that hits the first one visits only
     /// that box's leaf; one that hits none visits every box once, leaf after leaf in
@@ -1192,6 +1219,103 @@ mod tests {
         let (tests, median_tests) = (tests / root, median_tests / root);
         println!("{tests:.3} items tested a ray, {median_tests:.3} with median splits");
         assert!(tests <= 0.105 * median_tests, "{tests} {median_tests}");
+    }
+
+    /// The depth rule, from a subtree built at depth `MAX_SAH_DEPTH − 3` (as deep a
+    /// chain as real scenes rarely build): above `MAX_SAH_DEPTH` every split is the one
+    /// `best_split` picks for the node's items; from it on, every split halves the
+    /// items by count, sorted along the axis on which their centres spread widest
+    /// (worked out here from the boxes). 10,000 items, so that the first levels build
+    /// on two threads. The centres spread most along y, least along z, and lie far
+    /// out along x, so that taking another axis (the largest sum or ratio of the
+    /// bounds) changes the halves.
+    #[test]
+    fn splits_are_the_sah_s_down_to_its_depth_and_by_count_below() {
+        let mut rng = rand_mt::Mt64::new(48);
+        let mut unit = move || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32;
+        let boxes: Vec<Aabb> = (0..10_000)
+            .map(|k| {
+                // Eight clusters of unequal sizes, so that the SAH's splits are uneven.
+                let c = Vec3A::new(1000.0, (k % 8) as f32 * 0.4, 0.01 + (k % 3) as f32 * 0.1);
+                let spread = Vec3A::new(0.5, 0.3, 0.15) * (1.0 + (k % 8 * k % 5) as f32);
+                let p = c + Vec3A::new(unit(), unit(), unit()) * spread;
+                let h = Vec3A::splat(0.001 + 0.01 * unit());
+                Aabb {
+                    min: p - h,
+                    max: p + h,
+                }
+            })
+            .collect();
+        let centre = |k: u32| (boxes[k as usize].min + boxes[k as usize].max) * 0.5;
+        let mut items: Vec<BuildItem> = (0..boxes.len() as u32)
+            .map(|k| item(boxes[k as usize], k))
+            .collect();
+        let start = MAX_SAH_DEPTH - 3;
+        let mut nodes = Vec::new();
+        let bounds = Bounds::of(&items);
+        build_node(&mut items, bounds, 0, start, &mut nodes);
+        // The slots under binary node `b`.
+        fn slots(nodes: &[Node], b: usize) -> std::ops::Range<usize> {
+            let n = &nodes[b];
+            if n.count > 0 {
+                return n.index as usize..(n.index + n.count) as usize;
+            }
+            slots(nodes, b + 1).start..slots(nodes, n.index as usize).end
+        }
+        let (mut by_sah, mut by_count) = (0, 0);
+        let mut stack = vec![(0usize, start)];
+        while let Some((b, depth)) = stack.pop() {
+            if nodes[b].count > 0 {
+                assert!(nodes[b].count as usize <= MAX_LEAF);
+                continue;
+            }
+            let all = slots(&nodes, b);
+            let right = nodes[b].index as usize;
+            let left_slots = slots(&nodes, b + 1);
+            let mut left: Vec<u32> = items[left_slots.clone()].iter().map(|i| i.index).collect();
+            left.sort_unstable();
+            let node_items: Vec<u32> = items[all.clone()].iter().map(|i| i.index).collect();
+            if depth < MAX_SAH_DEPTH {
+                let mut copy: Vec<BuildItem> = node_items
+                    .iter()
+                    .map(|&k| item(boxes[k as usize], k))
+                    .collect();
+                let bounds = Bounds::of(&copy);
+                let split = best_split(&mut copy, &bounds).expect("a split");
+                let mut expected: Vec<u32> = copy
+                    .iter()
+                    .filter(|i| split.goes_left(i))
+                    .map(|i| i.index)
+                    .collect();
+                expected.sort_unstable();
+                assert_eq!(left, expected, "the SAH's split at depth {depth}");
+                by_sah += 1;
+            } else {
+                assert_eq!(left_slots.len(), all.len() / 2, "halves at depth {depth}");
+                let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+                for &k in &node_items {
+                    (lo, hi) = (lo.min(centre(k)), hi.max(centre(k)));
+                }
+                let axis = (hi - lo).max_position();
+                let left_max = left
+                    .iter()
+                    .map(|&k| centre(k)[axis])
+                    .fold(f32::MIN, f32::max);
+                let right_min = items[left_slots.end..all.end]
+                    .iter()
+                    .map(|i| centre(i.index)[axis])
+                    .fold(f32::MAX, f32::min);
+                assert!(
+                    left_max <= right_min,
+                    "sorted on axis {axis} at depth {depth}"
+                );
+                by_count += 1;
+            }
+            stack.push((b + 1, depth + 1));
+            stack.push((right, depth + 1));
+        }
+        println!("{by_sah} splits by the SAH, {by_count} by count");
+        assert!(by_sah >= 7 && by_count > 500, "{by_sah} {by_count}");
     }
 
     /// Boxes that share one centre (concentric spheres) cannot be split by position:

@@ -98,6 +98,16 @@ fn cells_of(
 const WIDEN: f64 = 1e-4;
 
 impl DirGrid {
+    /// Every sphere the grid lists, in any cell or in `always`, in index order.
+    #[cfg(test)]
+    pub(super) fn spheres_listed(&self) -> Vec<u32> {
+        let mut listed: Vec<u32> = self.items.iter().map(|&(k, _)| k).collect();
+        listed.extend(&self.always);
+        listed.sort_unstable();
+        listed.dedup();
+        listed
+    }
+
     /// Builds the grid around `centre` for spheres `(centre, radius)`; with `view`, for
     /// rays through it only: the spheres wholly outside it are left out.
     pub(super) fn build(

@@ -505,7 +505,7 @@ impl Spheres {
 #[cfg(test)]
 thread_local! {
     /// The exact tests run on this thread: the tests count the work the culling skips.
-    static EXACT_TESTS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    pub(crate) static EXACT_TESTS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
 /// [`Spheres::crossing_along`] of sphere `k`, given what the exact test reads of it.

@@ -30,6 +30,12 @@ impl PointGrid {
         self.grid.always.is_empty() && self.exact.len() == spheres
     }
 
+    /// Every sphere the grid lists, in index order.
+    #[cfg(test)]
+    pub(crate) fn spheres_listed(&self) -> Vec<u32> {
+        self.grid.spheres_listed()
+    }
+
     fn query(&self, d: Vec3) -> Query {
         Query {
             origin: self.grid.centre,

@@ -391,3 +391,55 @@ impl SampleTracer for FastTracer {
         (colour, skipped.weight * self.compiled.value_bound)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::EXACT_TESTS;
+    use crate::scene::{hw3_scene, Sphere, HW3_DEFAULT_SEED};
+
+    /// The tracer builds its eye's grid for the camera's view: a ball behind the camera
+    /// is left out of it (no primary ray could meet it), while the balls in front are
+    /// listed.
+    #[test]
+    fn the_eye_s_grid_leaves_out_a_ball_behind_the_camera() {
+        let mut scene = hw3_scene(HW3_DEFAULT_SEED);
+        let camera = scene.camera(160, 90).unwrap();
+        let film_centre = camera.lower_left + 0.5 * (camera.horizontal + camera.vertical);
+        let ahead = (film_centre - camera.origin).normalize();
+        let behind = scene.spheres.len() as u32;
+        scene
+            .spheres
+            .push(Sphere::new(camera.origin - 10.0 * ahead, 1.0));
+        let tracer = FastTracer::new(&scene, &camera, 5);
+        let listed = tracer.eye.spheres_listed();
+        assert!(!listed.contains(&behind), "{listed:?}");
+        assert!((0..4).all(|k| listed.contains(&k)), "{listed:?}");
+    }
+
+    /// A pair of diffuse hits lit in their tangent plane (n·L = 0 exactly: the ball at
+    /// (0, 0, −3) seen head-on at (0, 0, −2), the light at (5, 0, −2)) casts no shadow
+    /// ray: a ball on the segment to the light costs no exact test (`hand_computed`
+    /// counts the rays; this, the work a computed but unused factor would cost).
+    #[test]
+    fn diffuse_pairs_lit_in_their_tangent_plane_test_no_occluder() {
+        let exact_tests = |occluder: &str| {
+            let toml = format!(
+                "[camera]\norigin = [0, 0, 0]\nlower_left = [-1, -1, -1]\n\
+                 horizontal = [2, 0, 0]\nvertical = [0, 2, 0]\n\
+                 [image]\nwidth = 1\nheight = 1\n\
+                 [[light]]\nposition = [5, 0, -2]\n\
+                 [[sphere]]\ncenter = [0, 0, -3]\nradius = 1\n{occluder}"
+            );
+            let scene = Scene::from_toml_str(&toml, "test.toml").unwrap();
+            let tracer = FastTracer::new(&scene, &scene.camera(1, 1).unwrap(), 5);
+            let (mut out, mut rays) = ([Vec3::ONE; 2], RayCounts::default());
+            let before = EXACT_TESTS.with(|n| n.get());
+            tracer.sample_row(&[0.5, 0.5], 0.5, &mut out, &mut rays);
+            assert_eq!((out, rays.shadow), ([Vec3::ZERO; 2], 0));
+            EXACT_TESTS.with(|n| n.get()) - before
+        };
+        let on_the_segment = "[[sphere]]\ncenter = [2.5, 0, -2]\nradius = 0.5\n";
+        assert_eq!(exact_tests(on_the_segment), exact_tests(""));
+    }
+}

@@ -9,6 +9,7 @@ use glam::DVec3;
 use proptest::prop_assert;
 
 use super::{log_uniform, query, runner, unit_vector};
+use crate::accel::dirgrid::DirGrid;
 use crate::accel::view::ViewPyramid;
 use crate::accel::{eye_resolution, grid_resolution, may_cross, Ray, Spheres, EXACT_TESTS};
 use crate::model::Side;
@@ -89,6 +90,35 @@ fn a_shadow_ray_tests_no_ball_it_cannot_cross() {
     let q = query(DVec3::Y, -DVec3::Y, Some((0, Side::Outward)));
     let (tests, factor) = exact_tests(|| set.shadow_to_light(&q, 0.5, 0));
     assert_eq!((tests, factor), (0, 1.0));
+}
+
+/// A shadow query from the top of ball 0 to a light above it: ball 0 is in the
+/// light's cell (the light sees it there), but the segment leaves its outer side, so
+/// it costs no exact test.
+#[test]
+fn a_shadow_ray_skips_the_ball_it_leaves_among_the_light_s_candidates() {
+    let light = DVec3::new(0.0, 30.0, 0.0);
+    let set = Spheres::new(&row_of_balls()).with_light_grids(&[light]);
+    let q = query(DVec3::Y, DVec3::Y, Some((0, Side::Outward)));
+    let (tests, factor) = exact_tests(|| set.shadow_to_light(&q, 29.0, 0));
+    assert_eq!((tests, factor), (0, 1.0));
+}
+
+/// A shadow segment through the centre of the ball nearest the light meets its
+/// surface head-on (`l·n = −1`): a factor of 0, which no other occluder can lower, so
+/// the ball behind it on the segment is not tested.
+#[test]
+fn a_shadow_ray_stops_at_a_factor_of_0() {
+    let light = DVec3::new(0.0, 30.0, 0.0);
+    let set = Spheres::new(&[
+        Sphere::new(DVec3::ZERO, 1.0),
+        Sphere::new(DVec3::new(0.0, 10.0, 0.0), 1.0),
+        Sphere::new(DVec3::new(0.0, 20.0, 0.0), 1.0),
+    ])
+    .with_light_grids(&[light]);
+    let q = query(DVec3::Y, DVec3::Y, Some((0, Side::Outward)));
+    let (tests, factor) = exact_tests(|| set.shadow_to_light(&q, 29.0, 0));
+    assert_eq!((tests, factor), (1, 0.0));
 }
 
 /// The tracer's build gives the eye's grid its per-sphere records (its shortcuts read
@@ -190,6 +220,50 @@ fn overlap_lists_keep_no_sphere_beyond_their_allowance() {
             &set.overlapping(1)[..],
             &[2, 3],
             "around {centre} radius {r}"
+        );
+    }
+}
+
+/// A grid's `always` list (the spheres seen in every direction) takes a sphere whose
+/// surface passes within `10⁻⁶` of its radius and `10⁻⁹` of `|c − centre|∞` beyond
+/// the centre, for rounding: one beyond by half the second term is on it, one
+/// beyond by twice that is not. A small sphere near the centre, a large one far off.
+#[test]
+fn always_lists_the_spheres_around_the_centre_within_their_allowance() {
+    let centre = DVec3::new(3.0, -2.0, 1.0);
+    for r in [1e-3, 1e3] {
+        let beyond = |f: f64| {
+            // `|c − centre|∞` is the distance itself, along x.
+            let dist = r * (1.0 + 1e-6) / (1.0 - f * 1e-9);
+            (centre + DVec3::new(dist, 0.0, 0.0), r)
+        };
+        let grid = DirGrid::build(centre, &[beyond(0.5), beyond(2.0)], 12, None);
+        assert_eq!(grid.always, [0], "radius {r}");
+    }
+}
+
+/// A grid's entry holds a sphere's nearest distance from the centre, `|c − centre| −
+/// r`, less a margin for rounding of `10⁻⁶·(|c − centre| + r + |centre|∞)`, rounded
+/// down to `f32`: lower by that margin, within a tenth of it (queries stop at the
+/// first entry beyond their hit, so a larger margin costs work and a smaller one may
+/// lose a hit). A grid far from the origin and one at it.
+#[test]
+fn grid_entries_hold_the_nearest_distance_less_its_margin() {
+    for (centre, rel, r) in [
+        (DVec3::new(1e4, -2e3, 5.0), DVec3::new(0.0, 0.0, 3.0), 1.0),
+        (DVec3::ZERO, DVec3::new(0.0, 3.0, 0.0), 1.0),
+    ] {
+        let grid = DirGrid::build(centre, &[(centre + rel, r)], 12, None);
+        let cell = grid.cell(rel.normalize().as_vec3());
+        let &[(0, entry)] = grid.candidates(cell) else {
+            panic!("one entry, sphere 0");
+        };
+        let dist = rel.length();
+        let margin = 1e-6 * (dist + r + centre.abs().max_element());
+        let below = (dist - r) - f64::from(entry);
+        assert!(
+            (0.9 * margin..=1.1 * margin).contains(&below),
+            "{below:e} below, margin {margin:e}, grid at {centre}"
         );
     }
 }
