@@ -200,8 +200,8 @@ fn the_quick_test_rejects_a_line_a_few_roundings_outside() {
 
 /// Sphere 1's list of the spheres overlapping it allows `10⁻⁶` of the radii and
 /// `10⁻⁹` of the centres' distances from the origin for rounding: a sphere apart by
-/// more than twice that is not on it, a sphere touching it is. Small spheres near the
-/// origin and large ones far from it.
+/// more than twice that is not on it; a sphere touching it, or apart by half of it,
+/// is. Small spheres near the origin and large ones far from it.
 #[test]
 fn overlap_lists_keep_no_sphere_beyond_their_allowance() {
     for (centre, r) in [
@@ -215,10 +215,11 @@ fn overlap_lists_keep_no_sphere_beyond_their_allowance() {
             Sphere::new(centre, r),
             apart(0.0),
             apart(-0.5 * r),
+            apart(0.5 * allowance),
         ]);
         assert_eq!(
             &set.overlapping(1)[..],
-            &[2, 3],
+            &[2, 3, 4],
             "around {centre} radius {r}"
         );
     }
@@ -269,9 +270,11 @@ fn grid_entries_hold_the_nearest_distance_less_its_margin() {
 }
 
 /// The eye's grid keeps a sphere unless it lies wholly outside a side of the view
-/// pyramid by more than `10⁻⁶` of its radius and `10⁻⁹` of its centre's distance: a
-/// sphere outside by twice that is dropped, one that touches the side is kept. Small
-/// spheres near the eye, and small and large ones far from it.
+/// pyramid by more than `10⁻⁶` of its radius and `10⁻⁹` of its centre's distance
+/// and radius: a sphere outside by twice that is dropped; one that touches the side,
+/// or lies outside by half its radius's share of the `10⁻⁹` term less than the
+/// allowance, is kept. Small spheres near the eye, and small and large ones far from
+/// it.
 #[test]
 fn the_view_pyramid_drops_a_sphere_just_beyond_its_allowance() {
     // The film spans x and y in [−1, 1] at z = −1: the pyramid's right side leans out
@@ -290,6 +293,11 @@ fn the_view_pyramid_drops_a_sphere_just_beyond_its_allowance() {
         let allowance = 2e-6 * r + 2e-9 * (on_side.abs().max_element() + r);
         let at = |gap: f64| on_side + outward * (r + gap);
         assert!(view.may_see(at(0.0), r), "touching, depth {depth}");
+        let reach = 1e-6 * r + 1e-9 * (at(0.0).abs().max_element() + r);
+        assert!(
+            view.may_see(at(reach - 0.5e-9 * r), r),
+            "just inside, depth {depth}"
+        );
         assert!(
             !view.may_see(at(2.0 * allowance), r),
             "beyond, depth {depth}"
