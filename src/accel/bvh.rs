@@ -1221,8 +1221,9 @@ mod tests {
         assert!(tests <= 0.105 * median_tests, "{tests} {median_tests}");
     }
 
-    /// The depth rule, from a subtree built at depth `MAX_SAH_DEPTH − 3` (as deep a
-    /// chain as real scenes rarely build): above `MAX_SAH_DEPTH` every split is the one
+    /// The depth rule, on a subtree built from depth `MAX_SAH_DEPTH − 3` (`build_node`
+    /// takes the depth; a whole tree reaches it only through a chain of 45 SAH levels,
+    /// which real scenes do not build): above `MAX_SAH_DEPTH` every split is the one
     /// `best_split` picks for the node's items; from it on, every split halves the
     /// items by count, sorted along the axis on which their centres spread widest
     /// (worked out here from the boxes). 10,000 items, so that the first levels build

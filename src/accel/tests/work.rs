@@ -272,9 +272,8 @@ fn grid_entries_hold_the_nearest_distance_less_its_margin() {
 /// The eye's grid keeps a sphere unless it lies wholly outside a side of the view
 /// pyramid by more than `10⁻⁶` of its radius and `10⁻⁹` of its centre's distance
 /// and radius: a sphere outside by twice that is dropped; one that touches the side,
-/// or lies outside by half its radius's share of the `10⁻⁹` term less than the
-/// allowance, is kept. Small spheres near the eye, and small and large ones far from
-/// it.
+/// or lies outside by the allowance less `0.5·10⁻⁹·r` (half the radius's share of
+/// it), is kept. Small spheres near the eye, and small and large ones far from it.
 #[test]
 fn the_view_pyramid_drops_a_sphere_just_beyond_its_allowance() {
     // The film spans x and y in [−1, 1] at z = −1: the pyramid's right side leans out
