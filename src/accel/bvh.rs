@@ -626,6 +626,12 @@ mod tests {
         }
     }
 
+    /// Uniform `f32`s in [0, 1) from a seeded generator.
+    fn uniform_f32(seed: u64) -> impl FnMut() -> f32 {
+        let mut rng = rand_mt::Mt64::new(seed);
+        move || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32
+    }
+
     fn item(bounds: Aabb, index: u32) -> BuildItem {
         BuildItem {
             bounds,
@@ -816,8 +822,7 @@ mod tests {
     /// Clustered and spread boxes, some of one centre, 1 to 20,000 items.
     #[test]
     fn every_child_box_is_the_union_of_its_items_boxes() {
-        let mut rng = rand_mt::Mt64::new(7);
-        let mut unit = move || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32;
+        let mut unit = uniform_f32(7);
         for n in [1usize, 5, 33, 1000, 20_000] {
             let boxes: Vec<Aabb> = (0..n)
                 .map(|k| {
@@ -898,8 +903,7 @@ mod tests {
     /// every box. A tree of no items has none.
     #[test]
     fn overlapping_lists_the_leaves_whose_boxes_overlap() {
-        let mut rng = rand_mt::Mt64::new(3);
-        let mut unit = move || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32;
+        let mut unit = uniform_f32(3);
         let mut random_box = |spread: f32, size: f32| {
             let c = Vec3A::new(unit(), unit(), unit()) * spread;
             let h = Vec3A::new(unit(), unit(), unit()) * size;
@@ -1157,8 +1161,7 @@ mod tests {
     /// at most `MAX_LEAF` items (no two centres coincide).
     #[test]
     fn the_tree_beats_median_splits_by_the_surface_area_heuristic() {
-        let mut rng = rand_mt::Mt64::new(21);
-        let mut unit = move || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32;
+        let mut unit = uniform_f32(21);
         let clusters: Vec<(Vec3A, f32, f32)> = (0..60)
             .map(|_| {
                 let c = Vec3A::new(unit(), unit(), unit()) * 1000.0;
@@ -1232,8 +1235,7 @@ mod tests {
     /// bounds) changes the halves.
     #[test]
     fn splits_are_the_sah_s_down_to_its_depth_and_by_count_below() {
-        let mut rng = rand_mt::Mt64::new(48);
-        let mut unit = move || (rng.next_u64() >> 11) as f32 / (1u64 << 53) as f32;
+        let mut unit = uniform_f32(48);
         let boxes: Vec<Aabb> = (0..10_000)
             .map(|k| {
                 // Eight clusters of unequal sizes, so that the SAH's splits are uneven.

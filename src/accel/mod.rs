@@ -505,7 +505,15 @@ impl Spheres {
 #[cfg(test)]
 thread_local! {
     /// The exact tests run on this thread: the tests count the work the culling skips.
-    pub(crate) static EXACT_TESTS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    static EXACT_TESTS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// The exact tests `work` runs on this thread, and its result.
+#[cfg(test)]
+pub(crate) fn exact_tests<R>(work: impl FnOnce() -> R) -> (u64, R) {
+    let before = EXACT_TESTS.with(|n| n.get());
+    let result = work();
+    (EXACT_TESTS.with(|n| n.get()) - before, result)
 }
 
 /// [`Spheres::crossing_along`] of sphere `k`, given what the exact test reads of it.

@@ -395,7 +395,7 @@ impl SampleTracer for FastTracer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::EXACT_TESTS;
+    use crate::accel::exact_tests;
     use crate::scene::{hw3_scene, Sphere, HW3_DEFAULT_SEED};
 
     /// The tracer builds its eye's grid for the camera's view: a ball behind the camera
@@ -423,7 +423,7 @@ mod tests {
     /// counts the rays; this, the work a computed but unused factor would cost).
     #[test]
     fn diffuse_pairs_lit_in_their_tangent_plane_test_no_occluder() {
-        let exact_tests = |occluder: &str| {
+        let tests_with = |occluder: &str| {
             let toml = format!(
                 "[camera]\norigin = [0, 0, 0]\nlower_left = [-1, -1, -1]\n\
                  horizontal = [2, 0, 0]\nvertical = [0, 2, 0]\n\
@@ -434,12 +434,12 @@ mod tests {
             let scene = Scene::from_toml_str(&toml, "test.toml").unwrap();
             let tracer = FastTracer::new(&scene, &scene.camera(1, 1).unwrap(), 5);
             let (mut out, mut rays) = ([Vec3::ONE; 2], RayCounts::default());
-            let before = EXACT_TESTS.with(|n| n.get());
-            tracer.sample_row(&[0.5, 0.5], 0.5, &mut out, &mut rays);
+            let (tests, ()) =
+                exact_tests(|| tracer.sample_row(&[0.5, 0.5], 0.5, &mut out, &mut rays));
             assert_eq!((out, rays.shadow), ([Vec3::ZERO; 2], 0));
-            EXACT_TESTS.with(|n| n.get()) - before
+            tests
         };
         let on_the_segment = "[[sphere]]\ncenter = [2.5, 0, -2]\nradius = 0.5\n";
-        assert_eq!(exact_tests(on_the_segment), exact_tests(""));
+        assert_eq!(tests_with(on_the_segment), tests_with(""));
     }
 }

@@ -11,16 +11,9 @@ use proptest::prop_assert;
 use super::{log_uniform, query, runner, unit_vector};
 use crate::accel::dirgrid::DirGrid;
 use crate::accel::view::ViewPyramid;
-use crate::accel::{eye_resolution, grid_resolution, may_cross, Ray, Spheres, EXACT_TESTS};
+use crate::accel::{exact_tests, eye_resolution, grid_resolution, may_cross, Ray, Spheres};
 use crate::model::Side;
 use crate::scene::Sphere;
-
-/// The exact tests `work` runs on this thread, and its result.
-fn exact_tests<R>(work: impl FnOnce() -> R) -> (u64, R) {
-    let before = EXACT_TESTS.with(|n| n.get());
-    let result = work();
-    (EXACT_TESTS.with(|n| n.get()) - before, result)
-}
 
 /// Ball 0 at the origin, ball 1 ahead of it along +x, and three that no ray along the
 /// x axis meets: one beside it, one behind, one far off.
