@@ -500,7 +500,7 @@ fn a_folder_removed_mid_run_stops_the_animation_and_keeps_finished_files() {
         std::fs::create_dir(&gif).unwrap();
         let child = animation(200, &[&frames.join("f-%02d.png"), &gif.join("out.gif")]);
         wait_until("two frames", || finished(&frames) >= 2);
-        std::fs::remove_dir_all(removed).unwrap();
+        remove_while_written(removed);
         let out = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         let what = removed.file_name().unwrap().to_string_lossy();
@@ -519,6 +519,19 @@ fn a_folder_removed_mid_run_stops_the_animation_and_keeps_finished_files() {
             );
         }
         std::fs::remove_dir_all(kept).unwrap();
+    }
+}
+
+/// Removes `dir` as `rm -rf` would while a render still writes into it: a file the
+/// render creates between the listing and the last `rmdir` leaves the folder not
+/// empty, so the removal goes again until the folder is gone.
+fn remove_while_written(dir: &Path) {
+    for attempt in 1.. {
+        match std::fs::remove_dir_all(dir) {
+            Ok(()) => return,
+            Err(e) if e.kind() == std::io::ErrorKind::DirectoryNotEmpty && attempt < 100 => {}
+            Err(e) => panic!("removing {}: {e} (attempt {attempt})", dir.display()),
+        }
     }
 }
 
