@@ -80,7 +80,7 @@ impl Ray {
 /// never rejects a sphere the exact `f64` test would hit.
 const QUICK_SLACK: f32 = 1.0 / (1 << 18) as f32;
 
-/// Cells per face of the eye's grid: coarser than the lights' below 16k spheres. Larger
+/// Cells per face of the eye's grid: coarser than the lights' below 4k spheres. Larger
 /// cells leave more of them empty, so more runs of sky pixels skip the query, and put
 /// more runs of pixels in one cell to share its lookup; smaller cells keep a primary
 /// ray's list short. The steps grow with the scene, each at the fastest resolution
@@ -89,8 +89,10 @@ fn eye_resolution(spheres: usize) -> u32 {
     match spheres {
         0..=64 => 12,
         65..=256 => 32,
-        257..=16384 => 64,
-        _ => 192,
+        257..=4096 => 64,
+        4097..=65536 => 128,
+        65537..=262144 => 256,
+        _ => 384,
     }
 }
 

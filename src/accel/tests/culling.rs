@@ -577,8 +577,8 @@ fn nearest_sphere(q: &Query, spheres: &[Sphere]) -> Option<Option<u32>> {
     (!(all.iter().any(|x| x.3) || tie)).then(|| sorted.first().map(|x| x.0 as u32))
 }
 
-/// The finest grids (an eye grid for more than 16,384 spheres, the lights' 256-cell
-/// grids) and a hierarchy whose big subtrees are built on threads of their own: the
+/// Fine grids (the eye's 128 cells a face for 4,097 to 65,536 spheres, the lights'
+/// finest, 256) and a hierarchy whose big subtrees are built on threads of their own: the
 /// peers' scene of 20,000 balls on the ground, seen from its camera. Every primary
 /// ray's sphere, the shadow factor from its hit, and the sphere a ray from a point
 /// among the balls meets through the hierarchy, equal brute force in `f64`

@@ -139,8 +139,13 @@ fn grids_are_as_fine_as_their_scene_s_size_asks() {
         (65, 32),
         (256, 32),
         (257, 64),
-        (16_384, 64),
-        (16_385, 192),
+        (4_096, 64),
+        (4_097, 128),
+        (65_536, 128),
+        (65_537, 256),
+        (262_144, 256),
+        (262_145, 384),
+        (1 << 20, 384),
     ];
     for (spheres, cells) in eye {
         assert_eq!(eye_resolution(spheres), cells, "eye, {spheres} spheres");
