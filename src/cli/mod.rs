@@ -130,18 +130,18 @@ fn return_large_blocks() {
 #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
 fn return_large_blocks() {}
 
-/// glibc's malloc for a render that runs once and exits: blocks up to 32 MiB come from
-/// the heap (not mapped on their own), nothing is given back to the system before the
-/// exit, and all threads share one arena. The memory the load frees (the file's text,
-/// its tables) is then what the build and the frame take, not fresh pages, which the
-/// kernel maps and zeroes one fault at a time (about 2 µs a page on the 2-core
-/// machine of docs/speed.md; the build of many_100000 touched 15,000 of them).
+/// glibc's malloc for a render that runs once and exits: every block comes from the
+/// heap (none is mapped on its own, whatever its size), nothing is given back to the
+/// system before the exit, and all threads share one arena. The memory the load frees
+/// (the file's text, its tables) is then what the build and the frame take, not fresh
+/// pages, which the kernel maps and zeroes one fault at a time (about 2 µs a page on
+/// the 2-core machine of docs/speed.md; the build of a million spheres touched
+/// 118,000 of them when blocks over 32 MiB were mapped apart, 38,000 now).
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 pub(crate) fn keep_freed_blocks() {
-    const LARGEST_FROM_HEAP: libc::c_int = 32 * 1024 * 1024;
     // SAFETY: mallopt takes no pointers; it sets three of glibc's numbers.
     unsafe {
-        libc::mallopt(libc::M_MMAP_THRESHOLD, LARGEST_FROM_HEAP);
+        libc::mallopt(libc::M_MMAP_MAX, 0);
         libc::mallopt(libc::M_TRIM_THRESHOLD, libc::c_int::MAX);
         libc::mallopt(libc::M_ARENA_MAX, 1);
     }
