@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use super::round_down;
 use super::view::ViewPyramid;
 
-pub(super) struct DirGrid {
+pub(super) struct DirGrid<T = ()> {
     /// The point every ray of the grid passes through.
     pub(super) centre: DVec3,
     /// Cells per face side.
@@ -23,10 +23,21 @@ pub(super) struct DirGrid {
     half_n: f32,
     /// Cell `c` lists `items[offsets[c]..offsets[c+1]]`.
     offsets: Vec<u32>,
-    /// Per entry: the sphere, and its nearest distance from the centre rounded down.
-    items: Vec<(u32, f32)>,
+    /// The cells' entries, cell after cell.
+    items: Vec<Listed<T>>,
     /// Spheres that contain the centre: seen in every direction.
     pub(super) always: Vec<u32>,
+}
+
+/// A sphere in a cell's list: its index, its nearest distance from the centre rounded
+/// down, and what the grid's queries read of it first (`T`), kept in the entry so that
+/// a query reads its cell's list in order instead of one sphere's record elsewhere
+/// for each entry.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Listed<T> {
+    pub(super) k: u32,
+    pub(super) near: f32,
+    pub(super) data: T,
 }
 
 /// Spheres a unit of parallel work of the build: enough to outweigh its overhead.
@@ -98,24 +109,39 @@ fn cells_of(
 const WIDEN: f64 = 1e-4;
 
 impl DirGrid {
-    /// Every sphere the grid lists, in any cell or in `always`, in index order.
-    #[cfg(test)]
-    pub(super) fn spheres_listed(&self) -> Vec<u32> {
-        let mut listed: Vec<u32> = self.items.iter().map(|&(k, _)| k).collect();
-        listed.extend(&self.always);
-        listed.sort_unstable();
-        listed.dedup();
-        listed
-    }
-
-    /// Builds the grid around `centre` for spheres `(centre, radius)`; with `view`, for
-    /// rays through it only: the spheres wholly outside it are left out.
+    /// Builds the grid around `centre` for spheres `(centre, radius)`, with nothing but
+    /// their indices and distances in its lists (see [`DirGrid::build_with`]).
     pub(super) fn build(
         centre: DVec3,
         spheres: &[(DVec3, f64)],
         n: u32,
         view: Option<&ViewPyramid>,
     ) -> DirGrid {
+        DirGrid::build_with(centre, spheres, n, view, |_, _| ())
+    }
+}
+
+impl<T: Copy + Send + Sync> DirGrid<T> {
+    /// Every sphere the grid lists, in any cell or in `always`, in index order.
+    #[cfg(test)]
+    pub(super) fn spheres_listed(&self) -> Vec<u32> {
+        let mut listed: Vec<u32> = self.items.iter().map(|e| e.k).collect();
+        listed.extend(&self.always);
+        listed.sort_unstable();
+        listed.dedup();
+        listed
+    }
+
+    /// Builds the grid around `centre` for spheres `(centre, radius)`, each entry
+    /// carrying `data(centre, radius)` of its sphere; with `view`, for rays through it
+    /// only: the spheres wholly outside it are left out.
+    pub(super) fn build_with(
+        centre: DVec3,
+        spheres: &[(DVec3, f64)],
+        n: u32,
+        view: Option<&ViewPyramid>,
+        data: impl Fn(DVec3, f64) -> T + Sync,
+    ) -> DirGrid<T> {
         let faces = 6 * (n as usize) * (n as usize);
         // Visit spheres nearest first: the stable fill below then leaves every cell's
         // list sorted, so closest-hit queries can stop early. Each sphere's entry is its
@@ -139,9 +165,13 @@ impl DirGrid {
         // below then reads memory in order, and the gather's loads, independent of
         // each other, overlap (a million spheres are 32 MB, and a load in sorted order
         // misses the caches).
-        let sorted: Vec<((DVec3, f64), (u32, f32))> = entries
+        let sorted: Vec<((DVec3, f64), Listed<T>)> = entries
             .par_iter()
-            .map(|&(k, near)| (spheres[k as usize], (k, near)))
+            .map(|&(k, near)| {
+                let (c, r) = spheres[k as usize];
+                let data = data(c, r);
+                ((c, r), Listed { k, near, data })
+            })
             .collect();
         drop(entries);
 
@@ -154,7 +184,7 @@ impl DirGrid {
             .enumerate()
             .map(|(i, run)| {
                 let mut out = Run::with_room_for(run.len());
-                for (j, &((c, r), (k, _))) in run.iter().enumerate() {
+                for (j, &((c, r), Listed { k, .. })) in run.iter().enumerate() {
                     let place = (i * SPHERES_PER_RUN + j) as u32;
                     cells_of(centre, c, r, n, &cones, k, place, &mut out);
                 }
@@ -175,7 +205,11 @@ impl DirGrid {
             end += *offset;
             *offset = end;
         }
-        let mut items = vec![(0u32, 0.0f32); end as usize];
+        // Filled with any entry first (every place is written below).
+        let mut items = match sorted.first() {
+            Some(&(_, first)) => vec![first; end as usize],
+            None => Vec::new(),
+        };
         for &(cell, place) in runs.iter().rev().flat_map(|run| run.pairs.iter().rev()) {
             let start = &mut offsets[cell as usize];
             *start -= 1;
@@ -212,7 +246,7 @@ impl DirGrid {
 
     /// The spheres of a cell with their nearest distances, nearest first.
     #[inline]
-    pub(super) fn candidates(&self, cell: usize) -> &[(u32, f32)] {
+    pub(super) fn candidates(&self, cell: usize) -> &[Listed<T>] {
         let (start, end) = (self.offsets[cell] as usize, self.offsets[cell + 1] as usize);
         &self.items[start..end]
     }
@@ -503,7 +537,10 @@ mod tests {
         let (mut entries, mut widest) = (0, 0.0f64);
         for (cell, seen) in by_cell.iter().enumerate() {
             let list = grid.candidates(cell);
-            assert!(list.windows(2).all(|w| w[0].1 <= w[1].1), "cell {cell}");
+            assert!(
+                list.windows(2).all(|w| w[0].near <= w[1].near),
+                "cell {cell}"
+            );
             for (k, (c, r)) in spheres.iter().enumerate() {
                 let rel = *c - centre;
                 let dist = rel.length();
@@ -516,11 +553,11 @@ mod tests {
                     .iter()
                     .map(|d| d.dot(axis).clamp(-1.0, 1.0).acos() - half)
                     .fold(f64::INFINITY, f64::min);
-                let entry = list.iter().find(|e| e.0 == k as u32);
+                let entry = list.iter().find(|e| e.k == k as u32);
                 if outside < -1e-9 {
                     assert!(entry.is_some(), "cell {cell}: sphere {k} seen, not listed");
                 }
-                if let Some(&(_, near)) = entry {
+                if let Some(&super::Listed { near, .. }) = entry {
                     entries += 1;
                     widest = widest.max(outside / half_width);
                     assert!(
@@ -727,7 +764,7 @@ mod tests {
         }
         let grid = DirGrid::build(centre, &spheres, 4, None);
         let list = grid.candidates(grid.cell(glam::Vec3::Z));
-        let ks: Vec<u32> = list.iter().map(|&(k, _)| k).collect();
+        let ks: Vec<u32> = list.iter().map(|e| e.k).collect();
         let mut want: Vec<u32> = (0..40).filter(|k| k % 4 == 3).collect();
         want.extend((0..40).filter(|k| k % 4 < 2));
         want.extend((0..40).filter(|k| k % 4 == 2));

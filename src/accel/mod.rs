@@ -227,7 +227,7 @@ impl Spheres {
         let n = grid_resolution(list.len());
         self.lights = lights
             .par_iter()
-            .map(|&p| self.point_grid(DirGrid::build(p, &list, n, None)))
+            .map(|&p| PointGrid::build(p, &list, n))
             .collect();
         self
     }
@@ -243,43 +243,23 @@ impl Spheres {
     ) -> (Spheres, EyeGrid) {
         let list: Vec<(DVec3, f64)> = spheres.par_iter().map(|s| (s.center, s.radius)).collect();
         let n = grid_resolution(list.len());
-        let points: Vec<DVec3> = std::iter::once(eye).chain(lights.iter().copied()).collect();
-        let (base, grids) = rayon::join(
+        let eye_n = eye_resolution(list.len());
+        let (base, (eye_grid, lights)) = rayon::join(
             || Spheres::new(spheres),
             || {
-                let eye_n = eye_resolution(list.len());
-                points
-                    .par_iter()
-                    .enumerate()
-                    .map(|(i, &p)| {
-                        if i == 0 {
-                            DirGrid::build(p, &list, eye_n, view)
-                        } else {
-                            DirGrid::build(p, &list, n, None)
-                        }
-                    })
-                    .collect::<Vec<_>>()
+                rayon::join(
+                    || DirGrid::build(eye, &list, eye_n, view),
+                    || {
+                        lights
+                            .par_iter()
+                            .map(|&p| PointGrid::build(p, &list, n))
+                            .collect()
+                    },
+                )
             },
         );
-        let mut grids: Vec<PointGrid> = grids
-            .into_par_iter()
-            .enumerate()
-            .map(|(i, g)| {
-                if i == 0 {
-                    base.eye_point_grid(g)
-                } else {
-                    base.point_grid(g)
-                }
-            })
-            .collect();
-        let eye = grids.remove(0);
-        (
-            Spheres {
-                lights: grids,
-                ..base
-            },
-            eye,
-        )
+        let eye = base.eye_point_grid(eye_grid);
+        (Spheres { lights, ..base }, eye)
     }
 
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:

@@ -6,22 +6,53 @@
 use glam::{DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::dirgrid::DirGrid;
-use super::{round_down, round_up, unit64, Best, Hit, Query, Ray, Spheres, QUICK_SLACK};
+use super::dirgrid::{DirGrid, Listed};
+use super::{
+    quick_sphere, round_down, round_up, unit64, Best, Hit, Query, Ray, Spheres, QUICK_SLACK,
+};
 use crate::intersect::{power, roots_from};
 use crate::model::Side;
 
-/// A directional grid around a point (the camera origin or a light), with what the
-/// quick test of a ray through that point needs of each sphere worked out once: only
-/// the direction varies between such rays.
+/// The directional grid around a light, with what the quick test of a shadow ray
+/// towards it needs of each sphere worked out once and kept in the sphere's entries,
+/// so that a shadow ray reads its cell's list in order and nothing else until a
+/// sphere passes: only the direction varies between such rays.
 pub(crate) struct PointGrid {
+    grid: DirGrid<PointQuick>,
+}
+
+/// An entry of a light's grid: a sphere, its nearest distance and its quick test's
+/// constants.
+type Candidate = Listed<PointQuick>;
+
+impl PointGrid {
+    /// The grid around `point` for spheres `(centre, radius)` ([`DirGrid::build_with`]),
+    /// each entry with its sphere's [`PointQuick`] from `point`.
+    pub(super) fn build(point: DVec3, spheres: &[(DVec3, f64)], n: u32) -> PointGrid {
+        let quick = |c: DVec3, r: f64| PointQuick::new(point, c, quick_sphere(c, r));
+        PointGrid {
+            grid: DirGrid::build_with(point, spheres, n, None, quick),
+        }
+    }
+
+    /// The light the grid is around.
+    #[cfg(test)]
+    pub(crate) fn centre(&self) -> DVec3 {
+        self.grid.centre
+    }
+}
+
+/// The directional grid around a camera origin (see [`Spheres::eye_grid`]), with
+/// every sphere's record of what a primary ray's tests read of it. (A sphere lies in
+/// several of this grid's cells, about five at a million spheres: its record kept
+/// once, apart from the lists, costs a primary ray a load, where copies in the
+/// entries, as the lights' grids keep them, would cost the build 200 MB.)
+pub(crate) struct EyeGrid {
     grid: DirGrid,
-    quick: Vec<PointQuick>,
-    /// Around the eye only: per sphere, all that a primary ray's tests read of it.
     exact: Vec<EyeSphere>,
 }
 
-impl PointGrid {
+impl EyeGrid {
     /// Whether the eye's shortcuts ([`Spheres::closest_from_eye`], [`Spheres::eye_run`])
     /// apply to a scene of `spheres` spheres: an eye grid (with the per-sphere records,
     /// even when there is no sphere), and the eye inside no sphere (else the general
@@ -51,7 +82,7 @@ struct EyeStart<'a> {
     /// root and division then run while the grid is read, off the hit's critical path.
     d64: DVec3,
     /// The spheres of its cell, nearest first.
-    candidates: &'a [(u32, f32)],
+    candidates: &'a [Listed<()>],
 }
 
 impl<'a> EyeStart<'a> {
@@ -76,7 +107,7 @@ impl<'a> EyeStart<'a> {
 #[derive(Clone, Copy)]
 pub(crate) struct EyeRun<'a> {
     /// The cell's spheres, nearest first.
-    candidates: &'a [(u32, f32)],
+    candidates: &'a [Listed<()>],
 }
 
 impl<'a> EyeRun<'a> {
@@ -105,21 +136,17 @@ struct EyeSphere {
     inv_radius: f64,
 }
 
-/// The grid around a camera origin (see [`Spheres::eye_grid`]).
-pub(crate) type EyeGrid = PointGrid;
-
 /// One sphere as the quick test of rays through a grid's point sees it (see
 /// [`PointQuick::may_cross`]).
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 pub(super) struct PointQuick {
     /// `point − centre` in `f32`.
     f: Vec3,
     /// A ray of unit direction `d` misses when `(f·d)²` is below this: the closest
     /// point of its line is then farther than the (widened) radius plus the slack.
     min_bp2: f32,
-    /// The (widened) radius plus slack: the crossings lie within `reach` of `−f·d`.
-    reach: f32,
-    /// The slack of `−f·d` itself: the crossings lie within the half chord plus this.
+    /// The slack of `−f·d` itself: the crossings lie within the half chord plus this,
+    /// and within the radius plus this.
     tail: f32,
     /// The widened radius.
     radius: f32,
@@ -140,7 +167,6 @@ impl PointQuick {
         PointQuick {
             f,
             min_bp2,
-            reach: quick.w + tail,
             tail,
             radius: quick.w,
         }
@@ -151,8 +177,10 @@ impl PointQuick {
     #[inline(always)]
     pub(super) fn may_cross(&self, d: Vec3, t_max: f32) -> bool {
         let bp = -self.f.dot(d);
+        // The crossings lie within `reach` of `−f·d`.
+        let reach = self.radius + self.tail;
         // `&`, not `&&`: one branch on the outcome, not three on its parts.
-        (bp * bp >= self.min_bp2) & (bp + self.reach > 0.0) & (bp - self.reach < t_max)
+        (bp * bp >= self.min_bp2) & (bp + reach > 0.0) & (bp - reach < t_max)
     }
 
     /// [`PointQuick::may_cross`] for a ray whose line may pass up to `offset` from the
@@ -171,39 +199,23 @@ impl PointQuick {
 }
 
 impl Spheres {
-    /// `grid` with the quick-test constants of its point.
-    pub(super) fn point_grid(&self, grid: DirGrid) -> PointGrid {
-        let point = grid.centre;
-        let quick = self
-            .center
-            .par_iter()
-            .zip(&self.quick)
-            .map(|(&c, &q)| PointQuick::new(point, c, q))
-            .collect();
-        PointGrid {
-            grid,
-            quick,
-            exact: Vec::new(),
-        }
-    }
-
-    /// `grid` around the eye: [`Spheres::point_grid`] with the exact test's constants.
+    /// `grid` around the eye, with the tests' constants of every sphere.
     pub(super) fn eye_point_grid(&self, grid: DirGrid) -> EyeGrid {
         let eye = grid.centre;
-        let point = self.point_grid(grid);
-        let exact = point
-            .quick
+        let exact = self
+            .center
             .par_iter()
-            .zip(self.center.par_iter().zip(&self.radius))
-            .map(|(&quick, (&c, &radius))| EyeSphere {
-                quick,
+            .zip(&self.radius)
+            .zip(&self.quick)
+            .map(|((&c, &radius), &quick)| EyeSphere {
+                quick: PointQuick::new(eye, c, quick),
                 f: eye - c,
                 cterm: power(eye, c, radius),
                 radius,
                 inv_radius: 1.0 / radius,
             })
             .collect();
-        PointGrid { exact, ..point }
+        EyeGrid { grid, exact }
     }
 
     /// The closest hit of a primary ray: a ray from the centre of `eye`.
@@ -218,11 +230,11 @@ impl Spheres {
             self.consider(k, &ray, &mut best);
         }
         let mut t_max = round_up(best.t);
-        for &(k, near) in grid.candidates(grid.cell(q.dir)) {
+        for &Listed { k, near, .. } in grid.candidates(grid.cell(q.dir)) {
             if near >= t_max {
                 break; // the rest are all farther
             }
-            if eye.quick[k as usize].may_cross(q.dir, t_max) {
+            if eye.exact[k as usize].quick.may_cross(q.dir, t_max) {
                 if let Some(t) = self.consider_exactly(k, &ray, unit64(q.dir), &mut best) {
                     t_max = t;
                 }
@@ -307,7 +319,7 @@ impl Spheres {
         let d64 = start.d64;
         let mut best = Best::NONE;
         let mut t_max = f32::INFINITY;
-        for &(k, near) in start.candidates {
+        for &Listed { k, near, .. } in start.candidates {
             if near >= t_max {
                 break; // the rest are all farther
             }
@@ -385,12 +397,12 @@ impl Spheres {
         for &k in &lg.grid.always {
             self.occlude(k, ray, dist, light, &mut factor);
         }
-        for &(k, near) in start.candidates {
+        for &Listed { k, near, data } in start.candidates {
             if f64::from(near) >= dist || factor <= 0.0 {
                 break; // beyond the hit point, seen from the light
             }
             if ray.from == Some((k, Side::Outward))
-                || !lg.quick[k as usize].may_cross_near(start.back, start.dist32, start.offset)
+                || !data.may_cross_near(start.back, start.dist32, start.offset)
             {
                 continue;
             }
@@ -414,7 +426,7 @@ struct ShadowStart<'a> {
     /// start (the direction is off by at most ~1.5e-7 radians).
     offset: f32,
     /// The spheres of its cell of the light's grid, nearest the light first.
-    candidates: &'a [(u32, f32)],
+    candidates: &'a [Candidate],
 }
 
 impl<'a> ShadowStart<'a> {

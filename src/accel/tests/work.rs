@@ -9,7 +9,7 @@ use glam::DVec3;
 use proptest::prop_assert;
 
 use super::{log_uniform, query, runner, unit_vector};
-use crate::accel::dirgrid::DirGrid;
+use crate::accel::dirgrid::{DirGrid, Listed};
 use crate::accel::view::ViewPyramid;
 use crate::accel::{exact_tests, eye_resolution, grid_resolution, may_cross, Ray, Spheres};
 use crate::model::Side;
@@ -115,18 +115,15 @@ fn a_shadow_ray_stops_at_a_factor_of_0() {
 }
 
 /// The tracer's build gives the eye's grid its per-sphere records (its shortcuts read
-/// them) and the lights' grids none (they would never be read).
+/// them) and each light a grid around it.
 #[test]
-fn only_the_eye_s_grid_keeps_the_eye_s_records() {
+fn the_build_gives_the_eye_its_records_and_each_light_its_grid() {
     let spheres = row_of_balls();
     let lights = [DVec3::new(0.0, 30.0, 0.0), DVec3::new(20.0, 30.0, 5.0)];
     let (set, eye) = Spheres::build_for_view(&spheres, &lights, DVec3::new(0.0, 0.0, 9.0), None);
     assert!(eye.eye_shortcut_applies(spheres.len()));
-    assert_eq!(set.lights.len(), 2);
-    assert!(set
-        .lights
-        .iter()
-        .all(|light| !light.eye_shortcut_applies(spheres.len())));
+    let centres: Vec<DVec3> = set.lights.iter().map(|grid| grid.centre()).collect();
+    assert_eq!(centres, lights);
 }
 
 /// The cells a face of the eye's and the lights' grids, as docs/speed.md gives them
@@ -254,7 +251,10 @@ fn grid_entries_hold_the_nearest_distance_less_its_margin() {
     ] {
         let grid = DirGrid::build(centre, &[(centre + rel, r)], 12, None);
         let cell = grid.cell(rel.normalize().as_vec3());
-        let &[(0, entry)] = grid.candidates(cell) else {
+        let &[Listed {
+            k: 0, near: entry, ..
+        }] = grid.candidates(cell)
+        else {
             panic!("one entry, sphere 0");
         };
         let dist = rel.length();
