@@ -86,14 +86,29 @@ fn cells_of(
     }
     let sphere_cone = SphereCone::new(rel, dist, r);
     let (lo, hi) = (rel - DVec3::splat(reach), rel + DVec3::splat(reach));
-    let faces = match only_face(lo, hi) {
+    let single = only_face(lo, hi);
+    let faces = match single {
         Some(face) => face..face + 1,
         None => 0..6,
     };
     for face in faces {
-        let Some([u0, u1, v0, v1]) = face_rect(face, lo, hi, n) else {
+        let Some(mut rect) = face_rect(face, lo, hi, n) else {
             continue;
         };
+        // Only a rectangle of several cells a side has cells to drop.
+        let several = rect[0] < rect[1] || rect[2] < rect[3];
+        if let Some(tight) = single
+            .filter(|_| several)
+            .and_then(|face| silhouette_rect(face, rel, reach, n))
+        {
+            rect = [
+                rect[0].max(tight[0]),
+                rect[1].min(tight[1]),
+                rect[2].max(tight[2]),
+                rect[3].min(tight[3]),
+            ];
+        }
+        let [u0, u1, v0, v1] = rect;
         for v in v0..=v1 {
             for u in u0..=u1 {
                 if cones.meets(face, u, v, &sphere_cone) {
@@ -398,12 +413,7 @@ fn only_face(lo: DVec3, hi: DVec3) -> Option<u32> {
 /// The cells of `face` that the box `[lo, hi]` (relative to the centre) may be seen in,
 /// as `[u0, u1, v0, v1]`, or `None` when the box is not seen in that face.
 fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
-    let axis = (face / 2) as usize;
-    let (b, c) = match axis {
-        0 => (1, 2),
-        1 => (0, 2),
-        _ => (0, 1),
-    };
+    let (b, c, axis, _) = face_frame(face);
     // Coordinates with the face's axis pointing outwards.
     let (a_lo, a_hi) = if face.is_multiple_of(2) {
         (lo[axis], hi[axis])
@@ -434,9 +444,53 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
         let max = x_hi / if x_hi >= 0.0 { a_lo } else { a_hi };
         (min, max)
     };
-    let (u_lo, u_hi) = range(lo[b], hi[b]);
-    let (v_lo, v_hi) = range(lo[c], hi[c]);
-    let (u_lo, u_hi, v_lo, v_hi) = (u_lo - WIDEN, u_hi + WIDEN, v_lo - WIDEN, v_hi + WIDEN);
+    cells_within(range(lo[b], hi[b]), range(lo[c], hi[c]), n)
+}
+
+/// The axes of a face's coordinates (u, v) and of its outward axis, and the sign that
+/// turns the axis outwards.
+fn face_frame(face: u32) -> (usize, usize, usize, f64) {
+    let axis = (face / 2) as usize;
+    let (b, c) = match axis {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    let sign = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
+    (b, c, axis, sign)
+}
+
+/// The cells of `face` in which a sphere at `rel` (relative to the centre) of radius
+/// `reach` is seen, when it lies in front of the face's plane by more than twice its
+/// radius: the rectangle around its silhouette (the ellipse it projects to on the
+/// face), bounded in each face coordinate by the two planes through the centre
+/// tangent to the sphere. For a sphere off the face's axis it is tighter than its
+/// box's rectangle ([`face_rect`]), which reaches out to the box's corners. `None`
+/// for a sphere nearer the plane (there the bounds lose precision) or not seen in the
+/// face.
+fn silhouette_rect(face: u32, rel: DVec3, reach: f64, n: u32) -> Option<[u32; 4]> {
+    let (b, c, axis, sign) = face_frame(face);
+    let a = sign * rel[axis];
+    if a <= 2.0 * reach {
+        return None;
+    }
+    // The tangents from the centre to the circle of radius `reach` around (x, a), in
+    // the plane of x and the face's axis: x/a ± the half-angle, as slopes. With a >
+    // 2·reach, a² − reach² > 0.75·a² and the bounds carry an error of a few ε, far
+    // below the widening.
+    let denom = (a - reach) * (a + reach);
+    let inv = 1.0 / denom;
+    let range = |x: f64| {
+        let spread = reach * (x * x + denom).sqrt();
+        ((x * a - spread) * inv, (x * a + spread) * inv)
+    };
+    cells_within(range(rel[b]), range(rel[c]), n)
+}
+
+/// The cells of a face covering face coordinates `u` and `v` (ranges), widened by
+/// [`WIDEN`]; `None` when that leaves the face.
+fn cells_within(u: (f64, f64), v: (f64, f64), n: u32) -> Option<[u32; 4]> {
+    let (u_lo, u_hi, v_lo, v_hi) = (u.0 - WIDEN, u.1 + WIDEN, v.0 - WIDEN, v.1 + WIDEN);
     if u_lo > 1.0 || u_hi < -1.0 || v_lo > 1.0 || v_hi < -1.0 {
         return None;
     }
@@ -449,9 +503,9 @@ fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
 
 #[cfg(test)]
 mod tests {
-    use glam::DVec3;
+    use glam::{DVec2, DVec3};
 
-    use super::{face_rect, only_face, DirGrid, WIDEN};
+    use super::{face_rect, only_face, silhouette_rect, DirGrid, WIDEN};
 
     /// What a grid lists, against the spheres' geometry in `f64` and directions drawn at
     /// random (each placed in its cell by the queries' own [`DirGrid::cell`]): a sphere
@@ -629,6 +683,69 @@ mod tests {
 
     /// A face's axis, its sign, and the two axes across it (u, v), as `face_rect` and
     /// `from_face` number them.
+    /// The silhouette's rectangle of a sphere in front of a face: every direction to a
+    /// point of the sphere falls in one of its cells, and it reaches no further than
+    /// the widening past the farthest of those directions; for a sphere nearer the
+    /// face's plane than twice its radius there is none.
+    #[test]
+    fn silhouette_rect_holds_the_sphere_s_directions_and_no_more() {
+        let n = 64u32;
+        let mut rng = rand_mt::Mt64::new(12);
+        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let (mut sphere_points, mut near_the_plane) = (0, 0);
+        for _ in 0..3_000 {
+            let face = (unit() * 6.0) as u32;
+            let (a, s, b, c) = face_axes(face);
+            let dist = 0.5 + 50.0 * unit();
+            let r = dist * 0.7 * unit().powi(3);
+            let mut rel = DVec3::ZERO;
+            rel[a] = s * dist;
+            rel[b] = dist * (1.8 * unit() - 0.9);
+            rel[c] = dist * (1.8 * unit() - 0.9);
+            let Some([u0, u1, v0, v1]) = silhouette_rect(face, rel, r, n) else {
+                assert!(dist <= 2.0 * r, "{rel} {r}: no rectangle");
+                near_the_plane += 1;
+                continue;
+            };
+            // Points of the sphere, the rim seen from the centre among them: the
+            // tangent directions are the extremes.
+            let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(-f64::INFINITY));
+            for _ in 0..400 {
+                let (z, phi) = (2.0 * unit() - 1.0, std::f64::consts::TAU * unit());
+                let w = DVec3::new(
+                    (1.0 - z * z).sqrt() * phi.cos(),
+                    (1.0 - z * z).sqrt() * phi.sin(),
+                    z,
+                );
+                let p = rel + w * r;
+                let t = DVec2::new(p[b], p[c]) / (s * p[a]);
+                lo = lo.min(t);
+                hi = hi.max(t);
+                sphere_points += 1;
+            }
+            let cell = |x: f64| (((x + 1.0) * 0.5 * f64::from(n)) as u32).min(n - 1);
+            let (su0, su1, sv0, sv1) = (cell(lo.x), cell(hi.x), cell(lo.y), cell(hi.y));
+            assert!(
+                u0 <= su0 && su1 <= u1 && v0 <= sv0 && sv1 <= v1,
+                "{rel} {r}: points out"
+            );
+            let reach = |x: f64| cell(x + WIDEN);
+            let short = |x: f64| cell(x - WIDEN);
+            assert!(
+                u0 >= short(lo.x).saturating_sub(1) && u1 <= reach(hi.x) + 1,
+                "{rel} {r}: u {u0}..{u1} for points in {su0}..{su1}"
+            );
+            assert!(
+                v0 >= short(lo.y).saturating_sub(1) && v1 <= reach(hi.y) + 1,
+                "{rel} {r}: v {v0}..{v1} for points in {sv0}..{sv1}"
+            );
+        }
+        assert!(
+            sphere_points > 500_000 && near_the_plane > 100,
+            "{near_the_plane}"
+        );
+    }
+
     fn face_axes(face: u32) -> (usize, f64, usize, usize) {
         let axis = (face / 2) as usize;
         let (b, c) = [(1, 2), (0, 2), (0, 1)][axis];
