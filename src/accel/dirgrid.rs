@@ -861,6 +861,28 @@ mod tests {
         assert!(covered > 100_000 && behind > 10_000 && beyond > 10_000);
     }
 
+    /// A sphere whose box spans two cells on one side of a face but whose silhouette
+    /// lies in one cell is listed in that cell only: the box of the sphere of radius 1
+    /// at (1.1, 1.25, 10) reaches v = 2.25/9 = 0.25 (a border of the 8 cells a side,
+    /// 0.25 wide), its silhouette only v = (12.5 + √100.5625)/99 ≈ 0.2276; the second
+    /// sphere is the first with u and v swapped. (The cells' cones alone would keep
+    /// the neighbour across the border.)
+    #[test]
+    fn a_ball_whose_box_crosses_a_border_its_silhouette_does_not_fills_one_cell() {
+        let spheres = [
+            (DVec3::new(1.1, 1.25, 10.0), 1.0),
+            (DVec3::new(1.25, 1.1, 10.0), 1.0),
+        ];
+        let n = 8;
+        let grid = DirGrid::build(DVec3::ZERO, &spheres, n, None);
+        for (k, &(c, _)) in spheres.iter().enumerate() {
+            let cells: Vec<usize> = (0..6 * (n * n) as usize)
+                .filter(|&cell| grid.candidates(cell).iter().any(|e| e.k == k as u32))
+                .collect();
+            assert_eq!(cells, [grid.cell(c.as_vec3())], "sphere {k}");
+        }
+    }
+
     /// Spheres at one nearest distance (copies of one sphere, and copies of another
     /// exactly as far in another direction of the cell: 41 = |(0, 9, 40)|) are listed
     /// in the order of their indices, after the nearer ones and before the farther
