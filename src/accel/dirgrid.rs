@@ -33,7 +33,7 @@ pub(super) struct DirGrid<T = ()> {
 /// down, and what the grid's queries read of it first (`T`), kept in the entry so that
 /// a query reads its cell's list in order instead of one sphere's record elsewhere
 /// for each entry.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy)]
 pub(super) struct Listed<T> {
     pub(super) k: u32,
     pub(super) near: f32,
@@ -413,9 +413,9 @@ fn only_face(lo: DVec3, hi: DVec3) -> Option<u32> {
 /// The cells of `face` that the box `[lo, hi]` (relative to the centre) may be seen in,
 /// as `[u0, u1, v0, v1]`, or `None` when the box is not seen in that face.
 fn face_rect(face: u32, lo: DVec3, hi: DVec3, n: u32) -> Option<[u32; 4]> {
-    let (b, c, axis, _) = face_frame(face);
+    let (b, c, axis, sign) = face_frame(face);
     // Coordinates with the face's axis pointing outwards.
-    let (a_lo, a_hi) = if face.is_multiple_of(2) {
+    let (a_lo, a_hi) = if sign > 0.0 {
         (lo[axis], hi[axis])
     } else {
         (-hi[axis], -lo[axis])

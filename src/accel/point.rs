@@ -138,7 +138,7 @@ struct EyeSphere {
 
 /// One sphere as the quick test of rays through a grid's point sees it (see
 /// [`PointQuick::may_cross`]).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy)]
 pub(super) struct PointQuick {
     /// `point − centre` in `f32`.
     f: Vec3,
