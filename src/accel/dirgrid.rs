@@ -6,6 +6,7 @@
 //! Cells are filled conservatively (a sphere's bounding box, widened), so a query
 //! sees every sphere it could hit: the grid changes the work, never the answer.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 use glam::{DVec3, Vec3};
@@ -42,6 +43,57 @@ pub(super) struct Listed<T> {
 
 /// Spheres a unit of parallel work of the build: enough to outweigh its overhead.
 const SPHERES_PER_RUN: usize = 2048;
+
+/// The most entries a grid holds: [`ENTRIES_ANY`] and this many a sphere. Spheres a
+/// few of their radii from the centre each fill a large part of the cells (20,000
+/// balls of radius 1 around a light at 2.5 would list 330 million entries, 10 GB);
+/// past the bound the build stops and the rays through that point walk the hierarchy
+/// instead, which holds any scene's spheres in linear memory. Below it a grid pays
+/// for itself (hw3's light lists 12 thousand, many_1000000's 3.9 million; 240 large
+/// balls around a light, 0.76 million, render in 0.32 s with the grid and 0.57 s
+/// walking), above it walking does (2,000 of them, 7.5 million: 0.26 s against 0.02).
+const ENTRIES_PER_SPHERE: usize = 8;
+/// See [`ENTRIES_PER_SPHERE`].
+const ENTRIES_ANY: usize = 1 << 22;
+
+/// The bound of [`ENTRIES_PER_SPHERE`] for `spheres` spheres.
+fn most_entries(spheres: usize) -> usize {
+    ENTRIES_ANY + ENTRIES_PER_SPHERE * spheres
+}
+
+/// The coarsest grid a crowded scene falls back to, in cells a face side: below it a
+/// cell spans more than the sixth of a face's width, and the hierarchy serves better.
+const COARSEST: u32 = 32;
+
+/// At most as many entries as a grid of `n` cells a side around `centre` lists for
+/// `spheres` (those `view` may see): a sphere that does not hold the centre is seen in
+/// one cell at least, and in as many as its solid angle ω fills of the largest cell's,
+/// (2/n)² steradians at most (a face's middle cell, seen square on).
+fn fewest_entries(
+    centre: DVec3,
+    spheres: &[(DVec3, f64)],
+    n: u32,
+    view: Option<&ViewPyramid>,
+) -> f64 {
+    let largest_cell = (2.0 / f64::from(n)).powi(2);
+    spheres
+        .par_iter()
+        .filter(|&&(c, r)| view.is_none_or(|view| view.may_see(c - centre, r)))
+        .map(|&(c, r)| {
+            let dist = (c - centre).length();
+            if dist <= r {
+                return 0.0;
+            }
+            // ω = 2π(1 − cos θ), sin θ = r/dist; rounding errs far below the 1%.
+            let cos = (1.0 - (r / dist).powi(2)).sqrt();
+            let solid_angle = std::f64::consts::TAU * (1.0 - cos);
+            (0.99 * solid_angle / largest_cell).max(1.0)
+        })
+        .sum()
+}
+
+/// Entries a run of the build lists between two looks at the shared count of them.
+const PAIRS_PER_COUNT: usize = 1024;
 
 /// What a run of spheres adds to a grid.
 #[derive(Default)]
@@ -131,7 +183,7 @@ impl DirGrid {
         spheres: &[(DVec3, f64)],
         n: u32,
         view: Option<&ViewPyramid>,
-    ) -> DirGrid {
+    ) -> Option<DirGrid> {
         DirGrid::build_with(centre, spheres, n, view, |_, _| ())
     }
 }
@@ -149,14 +201,43 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
 
     /// Builds the grid around `centre` for spheres `(centre, radius)`, each entry
     /// carrying `data(centre, radius)` of its sphere; with `view`, for rays through it
-    /// only: the spheres wholly outside it are left out.
+    /// only: the spheres wholly outside it are left out. `None` when the spheres fill
+    /// the cells past [`most_entries`].
     pub(super) fn build_with(
         centre: DVec3,
         spheres: &[(DVec3, f64)],
         n: u32,
         view: Option<&ViewPyramid>,
         data: impl Fn(DVec3, f64) -> T + Sync,
-    ) -> DirGrid<T> {
+    ) -> Option<DirGrid<T>> {
+        let bound = most_entries(spheres.len());
+        if let Some(grid) = DirGrid::build_within(centre, spheres, n, view, &data, bound) {
+            return Some(grid);
+        }
+        // Crowded: a sphere seen over many cells fills a quarter of them at half the
+        // resolution. The coarser grids, finest first, skipping those that could not
+        // fit by their spheres' solid angles alone.
+        let mut m = n / 2;
+        while m >= COARSEST {
+            if fewest_entries(centre, spheres, m, view) <= bound as f64 {
+                if let Some(grid) = DirGrid::build_within(centre, spheres, m, view, &data, bound) {
+                    return Some(grid);
+                }
+            }
+            m /= 2;
+        }
+        None
+    }
+
+    /// [`DirGrid::build_with`] with at most `bound` entries.
+    fn build_within(
+        centre: DVec3,
+        spheres: &[(DVec3, f64)],
+        n: u32,
+        view: Option<&ViewPyramid>,
+        data: impl Fn(DVec3, f64) -> T + Sync,
+        bound: usize,
+    ) -> Option<DirGrid<T>> {
         let faces = 6 * (n as usize) * (n as usize);
         // Visit spheres nearest first: the stable fill below then leaves every cell's
         // list sorted, so closest-hit queries can stop early. Each sphere's entry is its
@@ -194,18 +275,32 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         // Each sphere's cells, in runs of spheres on rayon's threads; the runs come
         // back in order, so the pairs stay nearest first. A pair names the sphere by
         // its place in `sorted`.
+        // The runs add up their entries as they go, and all stop once the sum passes
+        // the bound.
+        let listed = AtomicUsize::new(0);
         let runs: Vec<Run> = sorted
             .par_chunks(SPHERES_PER_RUN)
             .enumerate()
             .map(|(i, run)| {
                 let mut out = Run::with_room_for(run.len());
+                let mut counted = 0;
                 for (j, &((c, r), Listed { k, .. })) in run.iter().enumerate() {
                     let place = (i * SPHERES_PER_RUN + j) as u32;
                     cells_of(centre, c, r, n, &cones, k, place, &mut out);
+                    if out.pairs.len() - counted >= PAIRS_PER_COUNT || j + 1 == run.len() {
+                        let new = out.pairs.len() - counted;
+                        counted = out.pairs.len();
+                        if listed.fetch_add(new, Ordering::Relaxed) + new > bound {
+                            break;
+                        }
+                    }
                 }
                 out
             })
             .collect();
+        if listed.into_inner() > bound {
+            return None;
+        }
         // Counting sort by cell, stable (it keeps the nearest-first order): `offsets[c]`
         // counts up to the end of cell c, then each entry, taken last to first, goes
         // just before its cell's end, which leaves `offsets[c]` at the cell's start. (A
@@ -231,14 +326,14 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
             items[*start as usize] = sorted[place as usize].1;
         }
         let always = runs.into_iter().flat_map(|run| run.always).collect();
-        DirGrid {
+        Some(DirGrid {
             centre,
             n,
             half_n: 0.5 * n as f32,
             offsets,
             items,
             always,
-        }
+        })
     }
 
     /// The cell of direction `d` (any length, not zero).
@@ -505,7 +600,10 @@ fn cells_within(u: (f64, f64), v: (f64, f64), n: u32) -> Option<[u32; 4]> {
 mod tests {
     use glam::{DVec2, DVec3};
 
-    use super::{face_rect, only_face, silhouette_rect, DirGrid, WIDEN};
+    use super::{
+        face_rect, fewest_entries, most_entries, only_face, silhouette_rect, DirGrid, COARSEST,
+        ENTRIES_ANY, ENTRIES_PER_SPHERE, SPHERES_PER_RUN, WIDEN,
+    };
 
     /// What a grid lists, against the spheres' geometry in `f64` and directions drawn at
     /// random (each placed in its cell by the queries' own [`DirGrid::cell`]): a sphere
@@ -561,7 +659,7 @@ mod tests {
                 }
             }
         }
-        let grid = DirGrid::build(centre, &spheres, n, None);
+        let grid = DirGrid::build(centre, &spheres, n, None).expect("within the bound");
 
         let mut samples: Vec<DVec3> = (0..400_000).map(|_| direction()).collect();
         samples.extend(diagonals);
@@ -649,8 +747,10 @@ mod tests {
                     scope.spawn(|| {
                         let spheres = [(DVec3::new(0.0, 0.0, 5.0), 1.0)];
                         for n in 300..360 {
-                            let grid =
-                                pool.install(|| DirGrid::build(DVec3::ZERO, &spheres, n, None));
+                            let grid = pool.install(|| {
+                                DirGrid::build(DVec3::ZERO, &spheres, n, None)
+                                    .expect("within the bound")
+                            });
                             assert!(grid.items.len() > 1, "the sphere is seen in several cells");
                         }
                     });
@@ -874,7 +974,7 @@ mod tests {
             (DVec3::new(1.25, 1.1, 10.0), 1.0),
         ];
         let n = 8;
-        let grid = DirGrid::build(DVec3::ZERO, &spheres, n, None);
+        let grid = DirGrid::build(DVec3::ZERO, &spheres, n, None).expect("within the bound");
         for (k, &(c, _)) in spheres.iter().enumerate() {
             let cells: Vec<usize> = (0..6 * (n * n) as usize)
                 .filter(|&cell| grid.candidates(cell).iter().any(|e| e.k == k as u32))
@@ -901,12 +1001,116 @@ mod tests {
                 _ => (centre + ahead * 0.5, 0.25),
             });
         }
-        let grid = DirGrid::build(centre, &spheres, 4, None);
+        let grid = DirGrid::build(centre, &spheres, 4, None).expect("within the bound");
         let list = grid.candidates(grid.cell(glam::Vec3::Z));
         let ks: Vec<u32> = list.iter().map(|e| e.k).collect();
         let mut want: Vec<u32> = (0..40).filter(|k| k % 4 == 3).collect();
         want.extend((0..40).filter(|k| k % 4 < 2));
         want.extend((0..40).filter(|k| k % 4 == 2));
         assert_eq!(ks, want);
+    }
+
+    /// The bound counts every entry of every run: a grid of `E` entries is built
+    /// within a bound of `E`, the same as without one, and not within `E − 1` (spheres
+    /// over several runs of the build, from small to ones seen over many cells).
+    #[test]
+    fn a_grid_is_built_within_a_bound_of_its_entries_and_not_below() {
+        let mut rng = rand_mt::Mt64::new(5);
+        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let spheres: Vec<(DVec3, f64)> = (0..3 * SPHERES_PER_RUN + 17)
+            .map(|_| {
+                let c = DVec3::new(unit(), unit(), unit()) * 20.0 - DVec3::splat(10.0);
+                (c, 0.01 + 0.5 * unit().powi(3))
+            })
+            .collect();
+        let centre = DVec3::new(0.5, 0.25, -0.125);
+        let build = |bound| DirGrid::build_within(centre, &spheres, 32, None, |_, _| (), bound);
+        let all = build(usize::MAX).expect("no bound");
+        let entries = all.items.len();
+        assert!(entries > 2 * spheres.len(), "{entries} entries");
+        let within = build(entries).expect("a bound of its entries");
+        assert_eq!(within.offsets, all.offsets);
+        let ks = |g: &DirGrid| g.items.iter().map(|e| e.k).collect::<Vec<_>>();
+        assert_eq!(ks(&within), ks(&all));
+        assert!(build(entries - 1).is_none());
+    }
+
+    /// `count` balls of radius `r` at distance `dist` from the origin, spread evenly
+    /// over the directions.
+    fn ring_of_balls(count: usize, dist: f64, r: f64) -> Vec<(DVec3, f64)> {
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        (0..count)
+            .map(|k| {
+                let z = 1.0 - 2.0 * (k as f64 + 0.5) / count as f64;
+                let s = (1.0 - z * z).sqrt();
+                let phi = golden * k as f64;
+                (DVec3::new(s * phi.cos(), s * phi.sin(), z) * dist, r)
+            })
+            .collect()
+    }
+
+    /// The entries of `n` cells a side that balls of angular radius asin(`r`/`dist`)
+    /// fill on average: each the fraction (1 − cos θ)/2 of the 6n² cells.
+    fn average_entries(count: usize, dist: f64, r: f64, n: u32) -> f64 {
+        let fraction = (1.0 - (1.0 - (r / dist).powi(2)).sqrt()) / 2.0;
+        count as f64 * fraction * 6.0 * f64::from(n * n)
+    }
+
+    /// Balls crowding the centre, each seen over a seventh of the sky, would fill more
+    /// cells than the bound allows: their grid comes at half the resolution, where a
+    /// ball fills a quarter as many; ten times as many of them fill even the coarsest
+    /// grid past the bound, and get none. Small balls farther out get the grid asked
+    /// for.
+    #[test]
+    fn crowding_balls_get_a_coarser_grid_or_none() {
+        let n = 128;
+        let (dist, r) = (1.45, 1.0);
+        let crowd = ring_of_balls(600, dist, r);
+        let bound = most_entries(crowd.len());
+        assert_eq!(bound, ENTRIES_ANY + ENTRIES_PER_SPHERE * 600);
+        assert!(average_entries(600, dist, r, n) > 1.5 * bound as f64);
+        assert!(average_entries(600, dist, r, n / 2) < 0.7 * bound as f64);
+        let grid = DirGrid::build(DVec3::ZERO, &crowd, n, None).expect("a coarser grid");
+        assert_eq!(grid.n, n / 2);
+        assert!(grid.items.len() <= bound);
+
+        let crowd = ring_of_balls(6000, dist, r);
+        let bound = most_entries(crowd.len()) as f64;
+        assert!(average_entries(6000, dist, r, COARSEST) > 1.1 * bound);
+        assert!(DirGrid::build(DVec3::ZERO, &crowd, n, None).is_none());
+
+        let small = ring_of_balls(600, 40.0, 0.1);
+        let grid = DirGrid::build(DVec3::ZERO, &small, n, None).expect("small balls fit");
+        assert_eq!(grid.n, n);
+    }
+
+    /// The skip of coarser grids relies on `fewest_entries` never exceeding the entries
+    /// a grid lists: for balls from tiny to ones filling half the sky, near and far, at
+    /// every resolution of the ladder.
+    #[test]
+    fn fewest_entries_is_at_most_the_entries_listed() {
+        let mut rng = rand_mt::Mt64::new(23);
+        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let centre = DVec3::new(0.25, -0.5, 0.75);
+        for trial in 0..12 {
+            let spheres: Vec<(DVec3, f64)> = (0..40 + 30 * trial)
+                .map(|_| {
+                    let dir = DVec3::new(unit(), unit(), unit()) * 2.0 - DVec3::ONE;
+                    let dist = 10f64.powf(2.0 * unit() - 1.0);
+                    let sin = 10f64.powf(-3.0 * unit()).min(0.999);
+                    (centre + dir.normalize_or(DVec3::X) * dist, dist * sin)
+                })
+                .collect();
+            for n in [32, 64, 96, 128] {
+                let fewest = fewest_entries(centre, &spheres, n, None);
+                let grid = DirGrid::build_within(centre, &spheres, n, None, |_, _| (), usize::MAX)
+                    .expect("no bound");
+                assert!(
+                    fewest <= grid.items.len() as f64,
+                    "trial {trial}, n {n}: {fewest} > {}",
+                    grid.items.len()
+                );
+            }
+        }
     }
 }

@@ -258,8 +258,8 @@ impl Spheres {
                 )
             },
         );
-        let eye = base.eye_point_grid(eye_grid);
-        (Spheres { lights, ..base }, eye)
+        let eye_grid = base.eye_point_grid(eye, eye_grid);
+        (Spheres { lights, ..base }, eye_grid)
     }
 
     /// The directional grid around a camera origin, for [`Spheres::closest_primary`]:
@@ -267,7 +267,10 @@ impl Spheres {
     /// answers rays through that pyramid only (a camera's primary rays).
     pub(crate) fn eye_grid(&self, eye: DVec3, view: Option<&ViewPyramid>) -> EyeGrid {
         let list = self.centres_and_radii();
-        self.eye_point_grid(DirGrid::build(eye, &list, eye_resolution(list.len()), view))
+        self.eye_point_grid(
+            eye,
+            DirGrid::build(eye, &list, eye_resolution(list.len()), view),
+        )
     }
 
     pub(crate) fn len(&self) -> usize {
@@ -459,8 +462,8 @@ impl Spheres {
     }
 
     /// The shadow factor along the segment of length `dist` to the light at `light`
-    /// (step 4 of the model), through the hierarchy.
-    #[cfg(test)]
+    /// (step 4 of the model), through the hierarchy: for a light without a grid, and
+    /// the tests' reference for those with one.
     pub(crate) fn shadow(&self, q: &Query, dist: f64, light: DVec3) -> f32 {
         let ray = Ray::new(q);
         let mut factor = 1.0f32;

@@ -16,9 +16,11 @@ use crate::model::Side;
 /// The directional grid around a light, with what the quick test of a shadow ray
 /// towards it needs of each sphere worked out once and kept in the sphere's entries,
 /// so that a shadow ray reads its cell's list in order and nothing else until a
-/// sphere passes: only the direction varies between such rays.
+/// sphere passes: only the direction varies between such rays. Without a grid (the
+/// spheres would fill it past its bound), shadow rays walk the hierarchy.
 pub(crate) struct PointGrid {
-    grid: DirGrid<PointQuick>,
+    centre: DVec3,
+    grid: Option<DirGrid<PointQuick>>,
 }
 
 /// An entry of a light's grid: a sphere, its nearest distance and its quick test's
@@ -31,6 +33,7 @@ impl PointGrid {
     pub(super) fn build(point: DVec3, spheres: &[(DVec3, f64)], n: u32) -> PointGrid {
         let quick = |c: DVec3, r: f64| PointQuick::new(point, c, quick_sphere(c, r));
         PointGrid {
+            centre: point,
             grid: DirGrid::build_with(point, spheres, n, None, quick),
         }
     }
@@ -38,7 +41,13 @@ impl PointGrid {
     /// The light the grid is around.
     #[cfg(test)]
     pub(crate) fn centre(&self) -> DVec3 {
-        self.grid.centre
+        self.centre
+    }
+
+    /// Whether shadow rays to this light read a grid (else they walk the hierarchy).
+    #[cfg(test)]
+    pub(crate) fn has_grid(&self) -> bool {
+        self.grid.is_some()
     }
 }
 
@@ -46,9 +55,11 @@ impl PointGrid {
 /// every sphere's record of what a primary ray's tests read of it. (A sphere lies in
 /// several of this grid's cells, about five at a million spheres: its record kept
 /// once, apart from the lists, costs a primary ray a load, where copies in the
-/// entries, as the lights' grids keep them, would cost the build 200 MB.)
+/// entries, as the lights' grids keep them, would cost the build 200 MB.) Without a
+/// grid (the spheres would fill it past its bound), primary rays walk the hierarchy.
 pub(crate) struct EyeGrid {
-    grid: DirGrid,
+    centre: DVec3,
+    grid: Option<DirGrid>,
     exact: Vec<EyeSphere>,
 }
 
@@ -58,18 +69,37 @@ impl EyeGrid {
     /// even when there is no sphere), and the eye inside no sphere (else the general
     /// query runs).
     pub(super) fn eye_shortcut_applies(&self, spheres: usize) -> bool {
-        self.grid.always.is_empty() && self.exact.len() == spheres
+        self.grid
+            .as_ref()
+            .is_some_and(|grid| grid.always.is_empty())
+            && self.exact.len() == spheres
     }
 
-    /// Every sphere the grid lists, in index order.
+    /// Every sphere the grid lists, in index order (none without a grid).
     #[cfg(test)]
     pub(crate) fn spheres_listed(&self) -> Vec<u32> {
-        self.grid.spheres_listed()
+        self.grid
+            .as_ref()
+            .map_or(Vec::new(), DirGrid::spheres_listed)
+    }
+
+    /// Whether primary rays read a grid (else they walk the hierarchy).
+    #[cfg(test)]
+    pub(crate) fn has_grid(&self) -> bool {
+        self.grid.is_some()
+    }
+
+    /// The grid, where [`EyeGrid::eye_shortcut_applies`] says it does.
+    #[inline(always)]
+    fn shortcut_grid(&self) -> &DirGrid {
+        self.grid
+            .as_ref()
+            .expect("the eye's shortcuts run with a grid only")
     }
 
     fn query(&self, d: Vec3) -> Query {
         Query {
-            origin: self.grid.centre,
+            origin: self.centre,
             dir: d,
             from: None,
         }
@@ -88,7 +118,7 @@ struct EyeStart<'a> {
 impl<'a> EyeStart<'a> {
     #[inline(always)]
     fn new(eye: &'a EyeGrid, d: Vec3) -> Self {
-        EyeStart::in_run(&EyeRun::of_cell(eye, eye.grid.cell(d)), d)
+        EyeStart::in_run(&EyeRun::of_cell(eye, eye.shortcut_grid().cell(d)), d)
     }
 
     /// For a direction of `run`: its cell's list is the run's.
@@ -114,7 +144,7 @@ impl<'a> EyeRun<'a> {
     #[inline(always)]
     fn of_cell(eye: &'a EyeGrid, cell: usize) -> Self {
         EyeRun {
-            candidates: eye.grid.candidates(cell),
+            candidates: eye.shortcut_grid().candidates(cell),
         }
     }
 
@@ -199,9 +229,16 @@ impl PointQuick {
 }
 
 impl Spheres {
-    /// `grid` around the eye, with the tests' constants of every sphere.
-    pub(super) fn eye_point_grid(&self, grid: DirGrid) -> EyeGrid {
-        let eye = grid.centre;
+    /// `grid` around the eye at `eye`, with the tests' constants of every sphere (none
+    /// without a grid).
+    pub(super) fn eye_point_grid(&self, eye: DVec3, grid: Option<DirGrid>) -> EyeGrid {
+        if grid.is_none() {
+            return EyeGrid {
+                centre: eye,
+                grid,
+                exact: Vec::new(),
+            };
+        }
         let exact = self
             .center
             .par_iter()
@@ -215,15 +252,22 @@ impl Spheres {
                 inv_radius: 1.0 / radius,
             })
             .collect();
-        EyeGrid { grid, exact }
+        EyeGrid {
+            centre: eye,
+            grid,
+            exact,
+        }
     }
 
     /// The closest hit of a primary ray: a ray from the centre of `eye`.
     pub(crate) fn closest_primary(&self, eye: &EyeGrid, q: &Query) -> Option<Hit> {
-        let grid = &eye.grid;
-        if grid.centre != q.origin || q.from.is_some() {
+        let Some(grid) = eye
+            .grid
+            .as_ref()
+            .filter(|_| eye.centre == q.origin && q.from.is_none())
+        else {
             return self.closest(q);
-        }
+        };
         let ray = Ray::new(q);
         let mut best = Best::NONE;
         for &k in &grid.always {
@@ -308,10 +352,12 @@ impl Spheres {
     /// many times over) and the eye is inside no sphere.
     #[inline(never)]
     pub(crate) fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
-        let grid = &eye.grid;
+        if !eye.eye_shortcut_applies(self.len()) {
+            return None;
+        }
+        let grid = eye.shortcut_grid();
         let cell = grid.cell(a);
-        let shortcut = eye.eye_shortcut_applies(self.len());
-        (shortcut && cell == grid.cell(b)).then(|| EyeRun::of_cell(eye, cell))
+        (cell == grid.cell(b)).then(|| EyeRun::of_cell(eye, cell))
     }
 
     #[inline(always)]
@@ -360,11 +406,15 @@ impl Spheres {
     }
 
     /// The shadow factor along the segment of length `dist` towards light `light`,
-    /// through the light's grid (the tracer builds one for every light).
+    /// through the light's grid (the tracer builds one for every light, unless the
+    /// spheres would fill it past its bound: then through the hierarchy).
     pub(crate) fn shadow_to_light(&self, q: &Query, dist: f64, light: usize) -> f32 {
         let lg = &self.lights[light];
-        let start = ShadowStart::new(lg, q, dist);
-        self.shadow_from_start(lg, &start)
+        let Some(grid) = &lg.grid else {
+            return self.shadow(q, dist, lg.centre);
+        };
+        let start = ShadowStart::new(grid, q, dist);
+        self.shadow_from_start(grid, &start)
     }
 
     /// [`Spheres::shadow_to_light`] of two segments at once (see
@@ -380,21 +430,27 @@ impl Spheres {
         light: usize,
     ) -> [f32; 2] {
         let lg = &self.lights[light];
+        let Some(grid) = &lg.grid else {
+            return [
+                self.shadow(a.0, a.1, lg.centre),
+                self.shadow(b.0, b.1, lg.centre),
+            ];
+        };
         let (start_a, start_b) = (
-            ShadowStart::new(lg, a.0, a.1),
-            ShadowStart::new(lg, b.0, b.1),
+            ShadowStart::new(grid, a.0, a.1),
+            ShadowStart::new(grid, b.0, b.1),
         );
         [
-            self.shadow_from_start(lg, &start_a),
-            self.shadow_from_start(lg, &start_b),
+            self.shadow_from_start(grid, &start_a),
+            self.shadow_from_start(grid, &start_b),
         ]
     }
 
     #[inline(always)]
-    fn shadow_from_start(&self, lg: &PointGrid, start: &ShadowStart<'_>) -> f32 {
-        let (ray, dist, light) = (&start.ray, start.dist, lg.grid.centre);
+    fn shadow_from_start(&self, grid: &DirGrid<PointQuick>, start: &ShadowStart<'_>) -> f32 {
+        let (ray, dist, light) = (&start.ray, start.dist, grid.centre);
         let mut factor = 1.0f32;
-        for &k in &lg.grid.always {
+        for &k in &grid.always {
             self.occlude(k, ray, dist, light, &mut factor);
         }
         for &Listed { k, near, data } in start.candidates {
@@ -431,8 +487,7 @@ struct ShadowStart<'a> {
 
 impl<'a> ShadowStart<'a> {
     #[inline(always)]
-    fn new(lg: &'a PointGrid, q: &Query, dist: f64) -> Self {
-        let grid = &lg.grid;
+    fn new(grid: &'a DirGrid<PointQuick>, q: &Query, dist: f64) -> Self {
         ShadowStart {
             ray: Ray::new(q),
             dist,

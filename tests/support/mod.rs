@@ -314,6 +314,47 @@ pub fn stress_scenes() -> Vec<Stress> {
             s
         },
     );
+    push(
+        "crowded-light",
+        "The camera and the light inside a small hollow walled by 600 overlapping balls \
+         of radius 1, a third mirrors and a third glass, with 40 small balls in the \
+         hollow: each big ball fills a ninth to a fifth of the sky seen from the light, \
+         too many cells for the light's directional grid at its resolution, so it gets \
+         one at half of it.",
+        {
+            let mut s = hw3();
+            let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+            let on_sphere = |k: usize, of: usize| {
+                let z = 1.0 - 2.0 * (k as f64 + 0.5) / of as f64;
+                let r = (1.0 - z * z).sqrt();
+                let phi = golden * k as f64;
+                DVec3::new(r * phi.cos(), r * phi.sin(), z)
+            };
+            s.spheres = (0..600)
+                .map(|k| {
+                    let c = on_sphere(k, 600) * (1.3 + 0.03 * (k * 7 % 11) as f64);
+                    let color = [0.3 + 0.5 * (k % 2) as f64, 0.5, 0.8 - 0.4 * (k % 3) as f64];
+                    let (reflect, transmit) = [(0.0, 0.0), (0.7, 0.0), (0.0, 0.8)][k % 3];
+                    ball(c.to_array(), 1.0, color, reflect, transmit)
+                })
+                .chain((0..40).map(|k| {
+                    let c = on_sphere(k, 40) * 0.2;
+                    ball(c.to_array(), 0.03, [0.9, 0.9, 0.2], 0.0, 0.0)
+                }))
+                .collect();
+            s.camera = Some(CameraSpec::LookAt {
+                look_from: DVec3::ZERO,
+                look_at: DVec3::new(0.0, -0.3, -1.0),
+                up: DVec3::Y,
+                vfov: 90.0,
+            });
+            s.lights = vec![Light {
+                position: DVec3::new(0.1, 0.05, -0.05),
+                intensity: DVec3::ONE,
+            }];
+            s
+        },
+    );
     out
 }
 

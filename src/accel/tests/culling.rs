@@ -655,3 +655,88 @@ fn large_scenes_lose_no_hit_or_occluder() {
     assert!(tested > 2500 && balls > 1000, "{tested} {balls}");
     assert!(shadows > 1500 && shadowed > 100, "{shadows} {shadowed}");
 }
+
+/// Balls crowding the eye and the light, each seen over a seventh of the sky from
+/// both, would fill even their coarsest grids past the bound: the build gives them
+/// none, and the eye's and the light's queries walk the hierarchy instead, losing
+/// nothing against brute force.
+#[test]
+fn a_crowded_eye_and_light_walk_the_hierarchy_and_lose_nothing() {
+    let count = 8000;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let on_sphere = |k: usize, of: usize| {
+        let z = 1.0 - 2.0 * (k as f64 + 0.5) / of as f64;
+        let s = (1.0 - z * z).sqrt();
+        let phi = golden * k as f64;
+        DVec3::new(s * phi.cos(), s * phi.sin(), z)
+    };
+    // With small balls in the hollow, which cast shadows on the crowd.
+    let small = 40;
+    let spheres: Vec<Sphere> = (0..count)
+        .map(|k| {
+            Sphere::new(
+                on_sphere(k, count) * (1.3 + 0.03 * (k * 7 % 11) as f64),
+                1.0,
+            )
+        })
+        .chain((0..small).map(|k| Sphere::new(on_sphere(k, small) * 0.2, 0.03)))
+        .collect();
+    let (eye, light) = (DVec3::ZERO, DVec3::new(0.1, 0.05, -0.05));
+    let (set, eye_grid) = Spheres::build_for_view(&spheres, &[light], eye, None);
+    assert!(!eye_grid.has_grid(), "the eye's grid would pass its bound");
+    assert!(
+        !set.lights[0].has_grid(),
+        "the light's grid would pass its bound"
+    );
+    let (mut checked, mut shadows, mut shadowed) = (0, 0, 0);
+    let rays = 1500;
+    for i in 0..rays {
+        let dir = on_sphere(i, rays).as_vec3().normalize();
+        let q = Query {
+            origin: eye,
+            dir,
+            from: None,
+        };
+        assert!(set.eye_run(&eye_grid, dir, dir).is_none());
+        let (o, d) = query_ray(&q);
+        let all = crossings(o, d, &spheres, None, 0.0);
+        let mut sorted: Vec<_> = all.iter().filter(|x| !x.1.is_nan()).collect();
+        sorted.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let tie = sorted.len() >= 2 && (sorted[1].1 - sorted[0].1) <= 1e-9 * sorted[1].1;
+        if all.iter().any(|x| x.3) || tie {
+            continue;
+        }
+        checked += 1;
+        let want = sorted.first().map(|x| x.0 as u32);
+        let pair = set.closest_from_eye_pair(&eye_grid, dir, dir);
+        for (name, got) in [
+            ("closest_primary", set.closest_primary(&eye_grid, &q)),
+            ("closest_from_eye", set.closest_from_eye(&eye_grid, dir)),
+            ("closest_from_eye_pair, first", pair[0]),
+            ("closest_from_eye_pair, second", pair[1]),
+        ] {
+            assert_eq!(got.map(|h| h.sphere), want, "{name}, ray {i}");
+        }
+        let Some(hit) = set.closest(&q) else { continue };
+        let (sq, dist, Some(want)) = shadow_case(&spheres, &hit, light) else {
+            continue;
+        };
+        shadows += 1;
+        shadowed += u32::from(want < 1.0);
+        let pair = set.shadow_to_light_pair((&sq, dist), (&sq, dist), 0);
+        for (name, got) in [
+            ("shadow_to_light", set.shadow_to_light(&sq, dist, 0)),
+            ("shadow_to_light_pair, first", pair[0]),
+            ("shadow_to_light_pair, second", pair[1]),
+        ] {
+            assert!(
+                (f64::from(got) - want).abs() <= 1e-5,
+                "{name}, ray {i}: factor {got}, f64 says {want}"
+            );
+        }
+    }
+    println!(
+        "crowded: {checked} primary rays checked, {shadows} shadow rays ({shadowed} shadowed)"
+    );
+    assert!(checked > 1000 && shadows > 500 && shadowed > 100);
+}

@@ -233,7 +233,8 @@ fn always_lists_the_spheres_around_the_centre_within_their_allowance() {
             let dist = r * (1.0 + 1e-6) / (1.0 - f * 1e-9);
             (centre + DVec3::new(dist, 0.0, 0.0), r)
         };
-        let grid = DirGrid::build(centre, &[beyond(0.5), beyond(2.0)], 12, None);
+        let grid = DirGrid::build(centre, &[beyond(0.5), beyond(2.0)], 12, None)
+            .expect("within the bound");
         assert_eq!(grid.always, [0], "radius {r}");
     }
 }
@@ -249,7 +250,8 @@ fn grid_entries_hold_the_nearest_distance_less_its_margin() {
         (DVec3::new(1e4, -2e3, 5.0), DVec3::new(0.0, 0.0, 3.0), 1.0),
         (DVec3::ZERO, DVec3::new(0.0, 3.0, 0.0), 1.0),
     ] {
-        let grid = DirGrid::build(centre, &[(centre + rel, r)], 12, None);
+        let grid =
+            DirGrid::build(centre, &[(centre + rel, r)], 12, None).expect("within the bound");
         let cell = grid.cell(rel.normalize().as_vec3());
         let &[Listed {
             k: 0, near: entry, ..
