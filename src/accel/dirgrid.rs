@@ -1038,15 +1038,8 @@ mod tests {
     /// `count` balls of radius `r` at distance `dist` from the origin, spread evenly
     /// over the directions.
     fn ring_of_balls(count: usize, dist: f64, r: f64) -> Vec<(DVec3, f64)> {
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        (0..count)
-            .map(|k| {
-                let z = 1.0 - 2.0 * (k as f64 + 0.5) / count as f64;
-                let s = (1.0 - z * z).sqrt();
-                let phi = golden * k as f64;
-                (DVec3::new(s * phi.cos(), s * phi.sin(), z) * dist, r)
-            })
-            .collect()
+        let directions = crate::accel::tests::even_directions(count);
+        directions.into_iter().map(|d| (d * dist, r)).collect()
     }
 
     /// The entries of `n` cells a side that balls of angular radius asin(`r`/`dist`)

@@ -662,24 +662,16 @@ fn large_scenes_lose_no_hit_or_occluder() {
 /// nothing against brute force.
 #[test]
 fn a_crowded_eye_and_light_walk_the_hierarchy_and_lose_nothing() {
-    let count = 8000;
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    let on_sphere = |k: usize, of: usize| {
-        let z = 1.0 - 2.0 * (k as f64 + 0.5) / of as f64;
-        let s = (1.0 - z * z).sqrt();
-        let phi = golden * k as f64;
-        DVec3::new(s * phi.cos(), s * phi.sin(), z)
-    };
     // With small balls in the hollow, which cast shadows on the crowd.
-    let small = 40;
-    let spheres: Vec<Sphere> = (0..count)
-        .map(|k| {
-            Sphere::new(
-                on_sphere(k, count) * (1.3 + 0.03 * (k * 7 % 11) as f64),
-                1.0,
-            )
-        })
-        .chain((0..small).map(|k| Sphere::new(on_sphere(k, small) * 0.2, 0.03)))
+    let spheres: Vec<Sphere> = even_directions(8000)
+        .into_iter()
+        .enumerate()
+        .map(|(k, d)| Sphere::new(d * (1.3 + 0.03 * (k * 7 % 11) as f64), 1.0))
+        .chain(
+            even_directions(40)
+                .into_iter()
+                .map(|d| Sphere::new(d * 0.2, 0.03)),
+        )
         .collect();
     let (eye, light) = (DVec3::ZERO, DVec3::new(0.1, 0.05, -0.05));
     let (set, eye_grid) = Spheres::build_for_view(&spheres, &[light], eye, None);
@@ -689,9 +681,8 @@ fn a_crowded_eye_and_light_walk_the_hierarchy_and_lose_nothing() {
         "the light's grid would pass its bound"
     );
     let (mut checked, mut shadows, mut shadowed) = (0, 0, 0);
-    let rays = 1500;
-    for i in 0..rays {
-        let dir = on_sphere(i, rays).as_vec3().normalize();
+    for (i, dir) in even_directions(1500).into_iter().enumerate() {
+        let dir = dir.as_vec3().normalize();
         let q = Query {
             origin: eye,
             dir,

@@ -30,6 +30,20 @@ pub(super) fn runner(cases: u32) -> TestRunner {
     )
 }
 
+/// `count` unit vectors spread evenly over the sphere of directions (a Fibonacci
+/// lattice: equal steps in z, the golden angle about it).
+pub(super) fn even_directions(count: usize) -> Vec<DVec3> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..count)
+        .map(|k| {
+            let z = 1.0 - 2.0 * (k as f64 + 0.5) / count as f64;
+            let s = (1.0 - z * z).sqrt();
+            let phi = golden * k as f64;
+            DVec3::new(s * phi.cos(), s * phi.sin(), z)
+        })
+        .collect()
+}
+
 /// A fast-path query from an `f64` spawn point and an `f64` direction rounded to `f32`
 /// and renormalised in `f32`, as the fast tracer makes them: the one place to change
 /// if the query's types change.
