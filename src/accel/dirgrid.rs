@@ -1106,4 +1106,53 @@ mod tests {
             }
         }
     }
+
+    /// `fewest_entries` by hand: a ball of angular radius θ counts its solid angle
+    /// 4π·sin²(θ/2) over the largest cell's (2/n)² steradians, less 1%; a small far
+    /// ball counts 1 and a ball around the centre 0; with a view, only the balls it
+    /// may see count. And for crowding balls the count is within a few times the
+    /// entries their grid lists, so that the skip it decides is worth deciding.
+    #[test]
+    fn fewest_entries_counts_solid_angles_in_largest_cells() {
+        let n = 64;
+        let theta = 0.5f64.asin(); // radius 1 at 2
+        let largest_cell = (2.0 / f64::from(n)).powi(2);
+        let one = 0.99 * 4.0 * std::f64::consts::PI * (theta / 2.0).sin().powi(2) / largest_cell;
+        let centre = DVec3::new(5.0, -3.0, 1.0);
+        let ahead = (centre + DVec3::new(0.0, 0.0, -2.0), 1.0);
+        let far_small = (centre + DVec3::new(0.0, 100.0, 0.0), 0.01);
+        let around = (centre + DVec3::new(0.1, 0.0, 0.0), 1.0);
+        let behind = (centre + DVec3::new(0.0, 0.0, 2.0), 1.0);
+        let count = |spheres: &[(DVec3, f64)], view| fewest_entries(centre, spheres, n, view);
+        let close = |got: f64, want: f64| (got - want).abs() <= 1e-9 * want;
+        assert!(
+            close(count(&[ahead], None), one),
+            "{}",
+            count(&[ahead], None)
+        );
+        assert_eq!(count(&[far_small], None), 1.0);
+        assert_eq!(count(&[around], None), 0.0);
+        let all = [ahead, far_small, around, behind];
+        assert!(close(count(&all, None), 2.0 * one + 1.0));
+        // Looking down −z through a film at distance 1: the ball behind is not seen.
+        let view = crate::accel::ViewPyramid::new(
+            centre,
+            centre + DVec3::new(-1.0, -1.0, -1.0),
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(0.0, 2.0, 0.0),
+        )
+        .expect("a pyramid");
+        assert!(close(count(&all, Some(&view)), one));
+
+        let crowd = ring_of_balls(300, 1.45, 1.0);
+        let fewest = fewest_entries(DVec3::ZERO, &crowd, n, None);
+        let listed = DirGrid::build_within(DVec3::ZERO, &crowd, n, None, |_, _| (), usize::MAX)
+            .expect("no bound")
+            .items
+            .len() as f64;
+        assert!(
+            fewest <= listed && listed <= 4.0 * fewest,
+            "{fewest} {listed}"
+        );
+    }
 }
