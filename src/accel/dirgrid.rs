@@ -65,6 +65,12 @@ fn most_entries(spheres: usize) -> usize {
 /// cell spans more than the sixth of a face's width, and the hierarchy serves better.
 const COARSEST: u32 = 32;
 
+/// The resolutions a crowded grid of `n` cells a side falls back to, finest first:
+/// halves of `n`, down to [`COARSEST`].
+fn coarser(n: u32) -> impl Iterator<Item = u32> {
+    std::iter::successors(Some(n / 2), |m| Some(m / 2)).take_while(|&m| m >= COARSEST)
+}
+
 /// At most as many entries as a grid of `n` cells a side around `centre` lists for
 /// `spheres` (those `view` may see): a sphere that does not hold the centre is seen in
 /// one cell at least, and in as many as its solid angle ω fills of the largest cell's,
@@ -217,16 +223,9 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         // Crowded: a sphere seen over many cells fills a quarter of them at half the
         // resolution. The coarser grids, finest first, skipping those that could not
         // fit by their spheres' solid angles alone.
-        let mut m = n / 2;
-        while m >= COARSEST {
-            if fewest_entries(centre, spheres, m, view) <= bound as f64 {
-                if let Some(grid) = DirGrid::build_within(centre, spheres, m, view, &data, bound) {
-                    return Some(grid);
-                }
-            }
-            m /= 2;
-        }
-        None
+        coarser(n)
+            .filter(|&m| fewest_entries(centre, spheres, m, view) <= bound as f64)
+            .find_map(|m| DirGrid::build_within(centre, spheres, m, view, &data, bound))
     }
 
     /// [`DirGrid::build_with`] with at most `bound` entries.
@@ -601,8 +600,8 @@ mod tests {
     use glam::{DVec2, DVec3};
 
     use super::{
-        face_rect, fewest_entries, most_entries, only_face, silhouette_rect, DirGrid, COARSEST,
-        ENTRIES_ANY, ENTRIES_PER_SPHERE, SPHERES_PER_RUN, WIDEN,
+        coarser, face_rect, fewest_entries, most_entries, only_face, silhouette_rect, DirGrid,
+        COARSEST, ENTRIES_ANY, ENTRIES_PER_SPHERE, SPHERES_PER_RUN, WIDEN,
     };
 
     /// What a grid lists, against the spheres' geometry in `f64` and directions drawn at
@@ -1154,5 +1153,42 @@ mod tests {
             fewest <= listed && listed <= 4.0 * fewest,
             "{fewest} {listed}"
         );
+    }
+
+    /// A crowded grid falls back to halves of its resolution, finest first, down to 32
+    /// cells a side and no further.
+    #[test]
+    fn crowded_grids_fall_back_to_halves_down_to_the_coarsest() {
+        let ladder = |n| coarser(n).collect::<Vec<u32>>();
+        assert_eq!(COARSEST, 32);
+        assert_eq!(ladder(384), [192, 96, 48]);
+        assert_eq!(ladder(256), [128, 64, 32]);
+        assert_eq!(ladder(128), [64, 32]);
+        assert_eq!(ladder(64), [32]);
+        assert!(ladder(63).is_empty());
+        assert!(ladder(12).is_empty());
+    }
+
+    /// A build stops at the first look at the shared count that finds it past the
+    /// bound, and gives no grid even when no other run adds to it: 1,500 balls each
+    /// seen in one cell only (tiny, on the cells' middle directions), in one run of
+    /// the build, whose count is looked at after every 1,024 entries.
+    #[test]
+    fn a_build_whose_count_reaches_the_bound_and_goes_on_gives_no_grid() {
+        let n = 32u32;
+        let middle = |i: u32| (2.0 * f64::from(i) + 1.0) / f64::from(n) - 1.0;
+        let spheres: Vec<(DVec3, f64)> = (0..1500u32)
+            .map(|k| {
+                let (u, v) = (middle(k % n), middle(k / n % n));
+                let z = if k < n * n { 1.0 } else { -1.0 };
+                (DVec3::new(u, v, z).normalize() * 10.0, 1e-4)
+            })
+            .collect();
+        let build = |bound| DirGrid::build_within(DVec3::ZERO, &spheres, n, None, |_, _| (), bound);
+        let all = build(usize::MAX).expect("no bound");
+        assert_eq!(all.items.len(), spheres.len(), "one cell each");
+        assert!(build(1500).is_some());
+        assert!(build(1024).is_none());
+        assert!(build(1023).is_none());
     }
 }
