@@ -1114,14 +1114,18 @@ mod tests {
     #[test]
     fn fewest_entries_counts_solid_angles_in_largest_cells() {
         let n = 64;
-        let theta = 0.5f64.asin(); // radius 1 at 2
         let largest_cell = (2.0 / f64::from(n)).powi(2);
-        let one = 0.99 * 4.0 * std::f64::consts::PI * (theta / 2.0).sin().powi(2) / largest_cell;
-        let centre = DVec3::new(5.0, -3.0, 1.0);
+        let by_hand = |sin_theta: f64| {
+            let half = sin_theta.asin() / 2.0;
+            0.99 * 4.0 * std::f64::consts::PI * half.sin().powi(2) / largest_cell
+        };
+        let one = by_hand(0.5); // radius 1 at 2
+        let half = by_hand(0.25); // radius 0.5 at 2
+        let centre = DVec3::new(5.0, -3.0, -1.0);
         let ahead = (centre + DVec3::new(0.0, 0.0, -2.0), 1.0);
         let far_small = (centre + DVec3::new(0.0, 100.0, 0.0), 0.01);
         let around = (centre + DVec3::new(0.1, 0.0, 0.0), 1.0);
-        let behind = (centre + DVec3::new(0.0, 0.0, 2.0), 1.0);
+        let behind = (centre + DVec3::new(0.0, 0.0, 2.0), 0.5);
         let count = |spheres: &[(DVec3, f64)], view| fewest_entries(centre, spheres, n, view);
         let close = |got: f64, want: f64| (got - want).abs() <= 1e-9 * want;
         assert!(
@@ -1132,7 +1136,7 @@ mod tests {
         assert_eq!(count(&[far_small], None), 1.0);
         assert_eq!(count(&[around], None), 0.0);
         let all = [ahead, far_small, around, behind];
-        assert!(close(count(&all, None), 2.0 * one + 1.0));
+        assert!(close(count(&all, None), one + half + 1.0));
         // Looking down −z through a film at distance 1: the ball behind is not seen.
         let view = crate::accel::ViewPyramid::new(
             centre,
