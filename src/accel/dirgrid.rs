@@ -44,14 +44,12 @@ pub(super) struct Listed<T> {
 /// Spheres a unit of parallel work of the build: enough to outweigh its overhead.
 const SPHERES_PER_RUN: usize = 2048;
 
-/// The most entries a grid holds: [`ENTRIES_ANY`] and this many a sphere. Spheres a
-/// few of their radii from the centre each fill a large part of the cells (20,000
-/// balls of radius 1 around a light at 2.5 would list 330 million entries, 10 GB);
-/// past the bound the build stops and the rays through that point walk the hierarchy
-/// instead, which holds any scene's spheres in linear memory. Below it a grid pays
-/// for itself (hw3's light lists 12 thousand, many_1000000's 3.9 million; 240 large
-/// balls around a light, 0.76 million, render in 0.32 s with the grid and 0.57 s
-/// walking), above it walking does (2,000 of them, 7.5 million: 0.26 s against 0.02).
+/// The most entries a grid holds: [`ENTRIES_ANY`] and this many a sphere. A sphere a
+/// few of its radii from the centre is seen in a large part of the cells, so a crowd
+/// of them would list millions of entries each (20,000 balls of radius 1 around a
+/// light at 2.5: 330 million, 10 GB); past the bound the build takes a coarser grid,
+/// and past the coarsest none (see [`DirGrid::build_with`]). Scenes of small spheres
+/// stay far below it (a million of them list 3.9 million entries around a light).
 const ENTRIES_PER_SPHERE: usize = 8;
 /// See [`ENTRIES_PER_SPHERE`].
 const ENTRIES_ANY: usize = 1 << 22;
@@ -61,8 +59,9 @@ fn most_entries(spheres: usize) -> usize {
     ENTRIES_ANY + ENTRIES_PER_SPHERE * spheres
 }
 
-/// The coarsest grid a crowded scene falls back to, in cells a face side: below it a
-/// cell spans more than the sixth of a face's width, and the hierarchy serves better.
+/// The coarsest grid a crowded scene falls back to, in cells a face side: coarser
+/// cells would each list most of the crowd, and the point's rays walk the hierarchy
+/// instead.
 const COARSEST: u32 = 32;
 
 /// The resolutions a crowded grid of `n` cells a side falls back to, finest first:
@@ -273,9 +272,8 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         let cones = CellCones::shared(n);
         // Each sphere's cells, in runs of spheres on rayon's threads; the runs come
         // back in order, so the pairs stay nearest first. A pair names the sphere by
-        // its place in `sorted`.
-        // The runs add up their entries as they go, and all stop once the sum passes
-        // the bound.
+        // its place in `sorted`. The runs add up their entries as they go, and all stop
+        // once the sum passes the bound.
         let listed = AtomicUsize::new(0);
         let runs: Vec<Run> = sorted
             .par_chunks(SPHERES_PER_RUN)

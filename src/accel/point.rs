@@ -17,7 +17,8 @@ use crate::model::Side;
 /// towards it needs of each sphere worked out once and kept in the sphere's entries,
 /// so that a shadow ray reads its cell's list in order and nothing else until a
 /// sphere passes: only the direction varies between such rays. Without a grid (the
-/// spheres would fill it past its bound), shadow rays walk the hierarchy.
+/// spheres would fill even the coarsest past its bound), shadow rays walk the
+/// hierarchy.
 pub(crate) struct PointGrid {
     centre: DVec3,
     grid: Option<DirGrid<PointQuick>>,
@@ -56,7 +57,8 @@ impl PointGrid {
 /// several of this grid's cells, about five at a million spheres: its record kept
 /// once, apart from the lists, costs a primary ray a load, where copies in the
 /// entries, as the lights' grids keep them, would cost the build 200 MB.) Without a
-/// grid (the spheres would fill it past its bound), primary rays walk the hierarchy.
+/// grid (the spheres would fill even the coarsest past its bound), primary rays walk
+/// the hierarchy.
 pub(crate) struct EyeGrid {
     centre: DVec3,
     grid: Option<DirGrid>,
@@ -407,7 +409,8 @@ impl Spheres {
 
     /// The shadow factor along the segment of length `dist` towards light `light`,
     /// through the light's grid (the tracer builds one for every light, unless the
-    /// spheres would fill it past its bound: then through the hierarchy).
+    /// spheres would fill even the coarsest past its bound: then through the
+    /// hierarchy).
     pub(crate) fn shadow_to_light(&self, q: &Query, dist: f64, light: usize) -> f32 {
         let lg = &self.lights[light];
         let Some(grid) = &lg.grid else {
