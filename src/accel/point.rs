@@ -66,15 +66,14 @@ pub(crate) struct EyeGrid {
 }
 
 impl EyeGrid {
-    /// Whether the eye's shortcuts ([`Spheres::closest_from_eye`], [`Spheres::eye_run`])
-    /// apply to a scene of `spheres` spheres: an eye grid (with the per-sphere records,
-    /// even when there is no sphere), and the eye inside no sphere (else the general
-    /// query runs).
-    pub(super) fn eye_shortcut_applies(&self, spheres: usize) -> bool {
+    /// The grid, when the eye's shortcuts ([`Spheres::closest_from_eye`],
+    /// [`Spheres::eye_run`]) apply to a scene of `spheres` spheres: an eye grid (with the
+    /// per-sphere records, even when there is no sphere), and the eye inside no sphere
+    /// (else the general query runs).
+    pub(super) fn shortcut(&self, spheres: usize) -> Option<&DirGrid> {
         self.grid
             .as_ref()
-            .is_some_and(|grid| grid.always.is_empty())
-            && self.exact.len() == spheres
+            .filter(|grid| grid.always.is_empty() && self.exact.len() == spheres)
     }
 
     /// Every sphere the grid lists, in index order (none without a grid).
@@ -89,14 +88,6 @@ impl EyeGrid {
     #[cfg(test)]
     pub(crate) fn has_grid(&self) -> bool {
         self.grid.is_some()
-    }
-
-    /// The grid, where [`EyeGrid::eye_shortcut_applies`] says it does.
-    #[inline(always)]
-    fn shortcut_grid(&self) -> &DirGrid {
-        self.grid
-            .as_ref()
-            .expect("the eye's shortcuts run with a grid only")
     }
 
     fn query(&self, d: Vec3) -> Query {
@@ -119,8 +110,8 @@ struct EyeStart<'a> {
 
 impl<'a> EyeStart<'a> {
     #[inline(always)]
-    fn new(eye: &'a EyeGrid, d: Vec3) -> Self {
-        EyeStart::in_run(&EyeRun::of_cell(eye, eye.shortcut_grid().cell(d)), d)
+    fn new(grid: &'a DirGrid, d: Vec3) -> Self {
+        EyeStart::in_run(&EyeRun::of_cell(grid, grid.cell(d)), d)
     }
 
     /// For a direction of `run`: its cell's list is the run's.
@@ -144,9 +135,9 @@ pub(crate) struct EyeRun<'a> {
 
 impl<'a> EyeRun<'a> {
     #[inline(always)]
-    fn of_cell(eye: &'a EyeGrid, cell: usize) -> Self {
+    fn of_cell(grid: &'a DirGrid, cell: usize) -> Self {
         EyeRun {
-            candidates: eye.shortcut_grid().candidates(cell),
+            candidates: grid.candidates(cell),
         }
     }
 
@@ -234,26 +225,22 @@ impl Spheres {
     /// `grid` around the eye at `eye`, with the tests' constants of every sphere (none
     /// without a grid).
     pub(super) fn eye_point_grid(&self, eye: DVec3, grid: Option<DirGrid>) -> EyeGrid {
-        if grid.is_none() {
-            return EyeGrid {
-                centre: eye,
-                grid,
-                exact: Vec::new(),
-            };
-        }
-        let exact = self
-            .center
-            .par_iter()
-            .zip(&self.radius)
-            .zip(&self.quick)
-            .map(|((&c, &radius), &quick)| EyeSphere {
-                quick: PointQuick::new(eye, c, quick),
-                f: eye - c,
-                cterm: power(eye, c, radius),
-                radius,
-                inv_radius: 1.0 / radius,
-            })
-            .collect();
+        let exact = match grid {
+            None => Vec::new(),
+            Some(_) => self
+                .center
+                .par_iter()
+                .zip(&self.radius)
+                .zip(&self.quick)
+                .map(|((&c, &radius), &quick)| EyeSphere {
+                    quick: PointQuick::new(eye, c, quick),
+                    f: eye - c,
+                    cterm: power(eye, c, radius),
+                    radius,
+                    inv_radius: 1.0 / radius,
+                })
+                .collect(),
+        };
         EyeGrid {
             centre: eye,
             grid,
@@ -292,10 +279,10 @@ impl Spheres {
     /// [`Spheres::closest_primary`] for the ray from the eye with unit direction `d`,
     /// with the origin's part of every test worked out beforehand (same results).
     pub(crate) fn closest_from_eye(&self, eye: &EyeGrid, d: Vec3) -> Option<Hit> {
-        if !eye.eye_shortcut_applies(self.len()) {
+        let Some(grid) = eye.shortcut(self.len()) else {
             return self.closest_primary(eye, &eye.query(d));
-        }
-        let start = EyeStart::new(eye, d);
+        };
+        let start = EyeStart::new(grid, d);
         self.closest_from_start(eye, d, start)
     }
 
@@ -312,13 +299,13 @@ impl Spheres {
         a: Vec3,
         b: Vec3,
     ) -> [Option<Hit>; 2] {
-        if !eye.eye_shortcut_applies(self.len()) {
+        let Some(grid) = eye.shortcut(self.len()) else {
             return [
                 self.closest_primary(eye, &eye.query(a)),
                 self.closest_primary(eye, &eye.query(b)),
             ];
-        }
-        let (start_a, start_b) = (EyeStart::new(eye, a), EyeStart::new(eye, b));
+        };
+        let (start_a, start_b) = (EyeStart::new(grid, a), EyeStart::new(grid, b));
         [
             self.closest_from_start(eye, a, start_a),
             self.closest_from_start(eye, b, start_b),
@@ -354,12 +341,9 @@ impl Spheres {
     /// many times over) and the eye is inside no sphere.
     #[inline(never)]
     pub(crate) fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
-        if !eye.eye_shortcut_applies(self.len()) {
-            return None;
-        }
-        let grid = eye.shortcut_grid();
+        let grid = eye.shortcut(self.len())?;
         let cell = grid.cell(a);
-        (cell == grid.cell(b)).then(|| EyeRun::of_cell(eye, cell))
+        (cell == grid.cell(b)).then(|| EyeRun::of_cell(grid, cell))
     }
 
     #[inline(always)]

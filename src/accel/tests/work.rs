@@ -121,7 +121,7 @@ fn the_build_gives_the_eye_its_records_and_each_light_its_grid() {
     let spheres = row_of_balls();
     let lights = [DVec3::new(0.0, 30.0, 0.0), DVec3::new(20.0, 30.0, 5.0)];
     let (set, eye) = Spheres::build_for_view(&spheres, &lights, DVec3::new(0.0, 0.0, 9.0), None);
-    assert!(eye.eye_shortcut_applies(spheres.len()));
+    assert!(eye.shortcut(spheres.len()).is_some());
     let centres: Vec<DVec3> = set.lights.iter().map(|grid| grid.centre()).collect();
     assert_eq!(centres, lights);
 }
