@@ -6,6 +6,7 @@
 //! Cells are filled conservatively (a sphere's bounding box, widened), so a query
 //! sees every sphere it could hit: the grid changes the work, never the answer.
 
+use std::cell::OnceCell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -55,8 +56,23 @@ const ENTRIES_PER_SPHERE: usize = 8;
 const ENTRIES_ANY: usize = 1 << 22;
 
 /// The bound of [`ENTRIES_PER_SPHERE`] for `spheres` spheres.
-fn most_entries(spheres: usize) -> usize {
+pub(super) fn most_entries(spheres: usize) -> usize {
     ENTRIES_ANY + ENTRIES_PER_SPHERE * spheres
+}
+
+/// The bound of each of `grids` grids around points that share one grid's bound
+/// ([`most_entries`]) for `spheres` spheres: the lights' grids, which serve equal
+/// numbers of rays (a diffuse hit casts a shadow ray to every light). Many lights
+/// then get coarser grids, or none, and their memory stays within one grid's
+/// whatever their number.
+pub(super) fn most_entries_each(spheres: usize, grids: usize) -> usize {
+    most_entries(spheres) / grids.max(1)
+}
+
+/// The room a grid of `n` cells a side and entries of `entry_bytes` takes besides
+/// its entries, in entries: its cells' offsets (4 bytes each).
+fn cell_places(n: u32, entry_bytes: usize) -> usize {
+    (6 * (n as usize) * (n as usize) + 1) * size_of::<u32>() / entry_bytes
 }
 
 /// The coarsest grid a crowded scene falls back to, in cells a face side: coarser
@@ -64,10 +80,14 @@ fn most_entries(spheres: usize) -> usize {
 /// instead.
 const COARSEST: u32 = 32;
 
-/// The resolutions a crowded grid of `n` cells a side falls back to, finest first:
-/// halves of `n`, down to [`COARSEST`].
-fn coarser(n: u32) -> impl Iterator<Item = u32> {
-    std::iter::successors(Some(n / 2), |m| Some(m / 2)).take_while(|&m| m >= COARSEST)
+/// The resolutions a crowded grid of `n` cells a side for `spheres` spheres falls
+/// back to, finest first: halves of `n`, down to [`COARSEST`] and to no fewer cells
+/// than spheres. (A crowd of large spheres fills fewer entries in coarser cells; small
+/// spheres fill a few at any resolution, and lists of more than one sphere a cell are
+/// slower to walk than the hierarchy.)
+fn coarser(n: u32, spheres: usize) -> impl Iterator<Item = u32> {
+    std::iter::successors(Some(n / 2), |m| Some(m / 2))
+        .take_while(move |&m| m >= COARSEST && 6 * (m as usize) * (m as usize) >= spheres)
 }
 
 /// At most as many entries as a grid of `n` cells a side around `centre` lists for
@@ -180,20 +200,80 @@ fn cells_of(
 /// the rounding of query directions many times over.
 const WIDEN: f64 = 1e-4;
 
+/// The spheres of a grid around `centre` (those `view` may see), nearest first, each
+/// with its entry: its index, its nearest distance from the centre rounded down (so
+/// that the early exit of queries stays conservative) and `data` of it. Visited in
+/// this order, the stable fill of the cells leaves every cell's list sorted, so
+/// closest-hit queries can stop early.
+fn nearest_first<T: Copy + Send + Sync>(
+    centre: DVec3,
+    spheres: &[(DVec3, f64)],
+    view: Option<&ViewPyramid>,
+    data: impl Fn(DVec3, f64) -> T + Sync,
+) -> Vec<((DVec3, f64), Listed<T>)> {
+    // A radix sort by the distance (in `total_cmp`'s order, stable, so ties stay in
+    // index order) reads no memory but the entries and decides no coin toss per
+    // comparison.
+    let mut entries: Vec<(u32, f32)> = spheres
+        .par_iter()
+        .with_min_len(SPHERES_PER_RUN)
+        .enumerate()
+        .filter(|&(_, &(c, r))| view.is_none_or(|view| view.may_see(c - centre, r)))
+        .map(|(k, &(c, r))| {
+            let dist = (c - centre).length();
+            let d = (dist - r) - 1e-6 * (dist + r + centre.abs().max_element());
+            (k as u32, round_down(d))
+        })
+        .collect();
+    radsort::sort_by_key(&mut entries, |&(_, near)| near);
+    // The spheres gathered in that order: the build's walk over runs then reads
+    // memory in order, and the gather's loads, independent of each other, overlap (a
+    // million spheres are 32 MB, and a load in sorted order misses the caches).
+    entries
+        .par_iter()
+        .map(|&(k, near)| {
+            let (c, r) = spheres[k as usize];
+            (
+                (c, r),
+                Listed {
+                    k,
+                    near,
+                    data: data(c, r),
+                },
+            )
+        })
+        .collect()
+}
+
 impl DirGrid {
     /// Builds the grid around `centre` for spheres `(centre, radius)`, with nothing but
-    /// their indices and distances in its lists (see [`DirGrid::build_with`]).
+    /// their indices and distances in its lists, within [`most_entries`] (see
+    /// [`DirGrid::build_with`]).
     pub(super) fn build(
         centre: DVec3,
         spheres: &[(DVec3, f64)],
         n: u32,
         view: Option<&ViewPyramid>,
     ) -> Option<DirGrid> {
-        DirGrid::build_with(centre, spheres, n, view, |_, _| ())
+        let bound = most_entries(spheres.len());
+        DirGrid::build_with(centre, spheres, n, view, |_, _| (), bound)
     }
 }
 
 impl<T: Copy + Send + Sync> DirGrid<T> {
+    /// Cells a face side.
+    #[cfg(test)]
+    pub(super) fn resolution(&self) -> u32 {
+        self.n
+    }
+
+    /// The room the grid takes in the unit of its bound: entries and cell offsets
+    /// (see [`cell_places`]).
+    #[cfg(test)]
+    pub(super) fn places(&self) -> usize {
+        self.items.len() + cell_places(self.n, size_of::<Listed<T>>())
+    }
+
     /// Every sphere the grid lists, in any cell or in `always`, in index order.
     #[cfg(test)]
     pub(super) fn spheres_listed(&self) -> Vec<u32> {
@@ -206,29 +286,10 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
 
     /// Builds the grid around `centre` for spheres `(centre, radius)`, each entry
     /// carrying `data(centre, radius)` of its sphere; with `view`, for rays through it
-    /// only: the spheres wholly outside it are left out. `None` when the spheres fill
-    /// the cells past [`most_entries`].
+    /// only: the spheres wholly outside it are left out. Its cells and entries together
+    /// stay within `bound` (see [`cell_places`]); `None` when even the coarsest grid
+    /// would pass it.
     pub(super) fn build_with(
-        centre: DVec3,
-        spheres: &[(DVec3, f64)],
-        n: u32,
-        view: Option<&ViewPyramid>,
-        data: impl Fn(DVec3, f64) -> T + Sync,
-    ) -> Option<DirGrid<T>> {
-        let bound = most_entries(spheres.len());
-        if let Some(grid) = DirGrid::build_within(centre, spheres, n, view, &data, bound) {
-            return Some(grid);
-        }
-        // Crowded: a sphere seen over many cells fills a quarter of them at half the
-        // resolution. The coarser grids, finest first, skipping those that could not
-        // fit by their spheres' solid angles alone.
-        coarser(n)
-            .filter(|&m| fewest_entries(centre, spheres, m, view) <= bound as f64)
-            .find_map(|m| DirGrid::build_within(centre, spheres, m, view, &data, bound))
-    }
-
-    /// [`DirGrid::build_with`] with at most `bound` entries.
-    fn build_within(
         centre: DVec3,
         spheres: &[(DVec3, f64)],
         n: u32,
@@ -236,39 +297,33 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         data: impl Fn(DVec3, f64) -> T + Sync,
         bound: usize,
     ) -> Option<DirGrid<T>> {
-        let faces = 6 * (n as usize) * (n as usize);
-        // Visit spheres nearest first: the stable fill below then leaves every cell's
-        // list sorted, so closest-hit queries can stop early. Each sphere's entry is its
-        // index and its nearest distance from the centre, rounded down so that the
-        // early exit of queries stays conservative; a radix sort by the distance (in
-        // `total_cmp`'s order, stable, so ties stay in index order) reads no memory but
-        // the entries and decides no coin toss per comparison.
-        let mut entries: Vec<(u32, f32)> = spheres
-            .par_iter()
-            .with_min_len(SPHERES_PER_RUN)
-            .enumerate()
-            .filter(|&(_, &(c, r))| view.is_none_or(|view| view.may_see(c - centre, r)))
-            .map(|(k, &(c, r))| {
-                let dist = (c - centre).length();
-                let d = (dist - r) - 1e-6 * (dist + r + centre.abs().max_element());
-                (k as u32, round_down(d))
-            })
-            .collect();
-        radsort::sort_by_key(&mut entries, |&(_, near)| near);
-        // The spheres gathered in that order, each with its entry: the walk over runs
-        // below then reads memory in order, and the gather's loads, independent of
-        // each other, overlap (a million spheres are 32 MB, and a load in sorted order
-        // misses the caches).
-        let sorted: Vec<((DVec3, f64), Listed<T>)> = entries
-            .par_iter()
-            .map(|&(k, near)| {
-                let (c, r) = spheres[k as usize];
-                let data = data(c, r);
-                ((c, r), Listed { k, near, data })
-            })
-            .collect();
-        drop(entries);
+        let room = |m: u32| bound.checked_sub(cell_places(m, size_of::<Listed<T>>()));
+        // Sorted once for every resolution tried, and not at all when none has room.
+        let sorted = OnceCell::new();
+        let sorted = || sorted.get_or_init(|| nearest_first(centre, spheres, view, &data));
+        let first = room(n).and_then(|r| DirGrid::build_within(centre, sorted(), n, r));
+        if first.is_some() {
+            return first;
+        }
+        // Crowded: a sphere seen over many cells fills a quarter of them at half the
+        // resolution, which has a quarter of the cells. The coarser grids, finest
+        // first, skipping those that could not fit by their cells or their spheres'
+        // solid angles alone.
+        coarser(n, spheres.len())
+            .filter_map(|m| Some((m, room(m)?)))
+            .filter(|&(m, r)| fewest_entries(centre, spheres, m, view) <= r as f64)
+            .find_map(|(m, r)| DirGrid::build_within(centre, sorted(), m, r))
+    }
 
+    /// The grid of `n` cells a side over the spheres `sorted` ([`nearest_first`]), with
+    /// at most `bound` entries.
+    fn build_within(
+        centre: DVec3,
+        sorted: &[((DVec3, f64), Listed<T>)],
+        n: u32,
+        bound: usize,
+    ) -> Option<DirGrid<T>> {
+        let faces = 6 * (n as usize) * (n as usize);
         let cones = CellCones::shared(n);
         // Each sphere's cells, in runs of spheres on rayon's threads; the runs come
         // back in order, so the pairs stay nearest first. A pair names the sphere by
@@ -598,8 +653,9 @@ mod tests {
     use glam::{DVec2, DVec3};
 
     use super::{
-        coarser, face_rect, fewest_entries, most_entries, only_face, silhouette_rect, DirGrid,
-        COARSEST, ENTRIES_ANY, ENTRIES_PER_SPHERE, SPHERES_PER_RUN, WIDEN,
+        cell_places, coarser, face_rect, fewest_entries, most_entries, nearest_first, only_face,
+        silhouette_rect, DirGrid, COARSEST, ENTRIES_ANY, ENTRIES_PER_SPHERE, SPHERES_PER_RUN,
+        WIDEN,
     };
 
     /// What a grid lists, against the spheres' geometry in `f64` and directions drawn at
@@ -1021,7 +1077,7 @@ mod tests {
             })
             .collect();
         let centre = DVec3::new(0.5, 0.25, -0.125);
-        let build = |bound| DirGrid::build_within(centre, &spheres, 32, None, |_, _| (), bound);
+        let build = |bound| within(centre, &spheres, 32, bound);
         let all = build(usize::MAX).expect("no bound");
         let entries = all.items.len();
         assert!(entries > 2 * spheres.len(), "{entries} entries");
@@ -1030,6 +1086,13 @@ mod tests {
         let ks = |g: &DirGrid| g.items.iter().map(|e| e.k).collect::<Vec<_>>();
         assert_eq!(ks(&within), ks(&all));
         assert!(build(entries - 1).is_none());
+    }
+
+    /// The grid of `n` cells a side around `centre` with at most `bound` entries, no
+    /// coarser one.
+    fn within(centre: DVec3, spheres: &[(DVec3, f64)], n: u32, bound: usize) -> Option<DirGrid> {
+        let sorted = nearest_first(centre, spheres, None, |_, _| ());
+        DirGrid::build_within(centre, &sorted, n, bound)
     }
 
     /// `count` balls of radius `r` at distance `dist` from the origin, spread evenly
@@ -1093,8 +1156,7 @@ mod tests {
                 .collect();
             for n in [32, 64, 96, 128] {
                 let fewest = fewest_entries(centre, &spheres, n, None);
-                let grid = DirGrid::build_within(centre, &spheres, n, None, |_, _| (), usize::MAX)
-                    .expect("no bound");
+                let grid = within(centre, &spheres, n, usize::MAX).expect("no bound");
                 assert!(
                     fewest <= grid.items.len() as f64,
                     "trial {trial}, n {n}: {fewest} > {}",
@@ -1147,7 +1209,7 @@ mod tests {
 
         let crowd = ring_of_balls(300, 1.45, 1.0);
         let fewest = fewest_entries(DVec3::ZERO, &crowd, n, None);
-        let listed = DirGrid::build_within(DVec3::ZERO, &crowd, n, None, |_, _| (), usize::MAX)
+        let listed = within(DVec3::ZERO, &crowd, n, usize::MAX)
             .expect("no bound")
             .items
             .len() as f64;
@@ -1157,11 +1219,33 @@ mod tests {
         );
     }
 
+    /// A grid's cells count against its bound in its entries' size (6n² + 1 offsets of
+    /// 4 bytes): with room for the cells and the entries a build gives the grid asked
+    /// for, with one place less the coarser one, and with room for the coarsest's
+    /// cells but not its entries none.
+    #[test]
+    fn cells_count_against_the_bound_in_the_entries_size() {
+        assert_eq!(cell_places(32, 32), 768); // 6,145 · 4 / 32 = 768.1
+        assert_eq!(cell_places(256, 8), 196_608); // 393,217 · 4 / 8 = 196,608.5
+        assert_eq!(cell_places(64, 4), 24_577);
+        let (n, balls) = (64, ring_of_balls(100, 40.0, 0.1));
+        let build = |bound| DirGrid::build_with(DVec3::ZERO, &balls, n, None, |_, _| (), bound);
+        let all = within(DVec3::ZERO, &balls, n, usize::MAX).expect("no bound");
+        let needs = all.items.len() + cell_places(n, 8);
+        assert_eq!(build(needs).map(|g| g.n), Some(n));
+        assert_eq!(build(needs - 1).map(|g| g.n), Some(n / 2));
+        assert!(build(cell_places(COARSEST, 8) + balls.len() - 1).is_none());
+    }
+
     /// A crowded grid falls back to halves of its resolution, finest first, down to 32
-    /// cells a side and no further.
+    /// cells a side and no further, and to no fewer cells than spheres.
     #[test]
     fn crowded_grids_fall_back_to_halves_down_to_the_coarsest() {
-        let ladder = |n| coarser(n).collect::<Vec<u32>>();
+        let ladder = |n| coarser(n, 0).collect::<Vec<u32>>();
+        // 6·64² = 24,576 cells, 6·128² = 98,304.
+        assert_eq!(coarser(256, 24_576).collect::<Vec<u32>>(), [128, 64]);
+        assert_eq!(coarser(256, 24_577).collect::<Vec<u32>>(), [128]);
+        assert_eq!(coarser(256, 98_305).count(), 0);
         assert_eq!(COARSEST, 32);
         assert_eq!(ladder(384), [192, 96, 48]);
         assert_eq!(ladder(256), [128, 64, 32]);
@@ -1186,7 +1270,7 @@ mod tests {
                 (DVec3::new(u, v, z).normalize() * 10.0, 1e-4)
             })
             .collect();
-        let build = |bound| DirGrid::build_within(DVec3::ZERO, &spheres, n, None, |_, _| (), bound);
+        let build = |bound| within(DVec3::ZERO, &spheres, n, bound);
         let all = build(usize::MAX).expect("no bound");
         assert_eq!(all.items.len(), spheres.len(), "one cell each");
         assert!(build(1500).is_some());

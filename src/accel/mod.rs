@@ -96,6 +96,11 @@ fn eye_resolution(spheres: usize) -> u32 {
     }
 }
 
+/// The bound of each light's grid: the lights share one grid's.
+fn light_bound(spheres: &[(DVec3, f64)], lights: &[DVec3]) -> usize {
+    dirgrid::most_entries_each(spheres.len(), lights.len())
+}
+
 /// Cells per face of the lights' directional grids. A render pays for every cell once
 /// (its offset is fresh memory, its cone worked out once per process), which a warm
 /// frame does not show: hw3's shadow rays are as fast with 64 cells as with 128, and
@@ -224,10 +229,10 @@ impl Spheres {
     #[cfg(test)]
     pub(crate) fn with_light_grids(mut self, lights: &[DVec3]) -> Self {
         let list = self.centres_and_radii();
-        let n = grid_resolution(list.len());
+        let (n, bound) = (grid_resolution(list.len()), light_bound(&list, lights));
         self.lights = lights
             .par_iter()
-            .map(|&p| PointGrid::build(p, &list, n))
+            .map(|&p| PointGrid::build(p, &list, n, bound))
             .collect();
         self
     }
@@ -242,7 +247,7 @@ impl Spheres {
         view: Option<&ViewPyramid>,
     ) -> (Spheres, EyeGrid) {
         let list: Vec<(DVec3, f64)> = spheres.par_iter().map(|s| (s.center, s.radius)).collect();
-        let n = grid_resolution(list.len());
+        let (n, bound) = (grid_resolution(list.len()), light_bound(&list, lights));
         let eye_n = eye_resolution(list.len());
         let (base, (eye_grid, lights)) = rayon::join(
             || Spheres::new(spheres),
@@ -252,7 +257,7 @@ impl Spheres {
                     || {
                         lights
                             .par_iter()
-                            .map(|&p| PointGrid::build(p, &list, n))
+                            .map(|&p| PointGrid::build(p, &list, n, bound))
                             .collect()
                     },
                 )

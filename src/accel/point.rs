@@ -29,13 +29,14 @@ pub(crate) struct PointGrid {
 type Candidate = Listed<PointQuick>;
 
 impl PointGrid {
-    /// The grid around `point` for spheres `(centre, radius)` ([`DirGrid::build_with`]),
-    /// each entry with its sphere's [`PointQuick`] from `point`.
-    pub(super) fn build(point: DVec3, spheres: &[(DVec3, f64)], n: u32) -> PointGrid {
+    /// The grid around `point` for spheres `(centre, radius)` within `bound`
+    /// ([`DirGrid::build_with`]), each entry with its sphere's [`PointQuick`] from
+    /// `point`.
+    pub(super) fn build(point: DVec3, spheres: &[(DVec3, f64)], n: u32, bound: usize) -> PointGrid {
         let quick = |c: DVec3, r: f64| PointQuick::new(point, c, quick_sphere(c, r));
         PointGrid {
             centre: point,
-            grid: DirGrid::build_with(point, spheres, n, None, quick),
+            grid: DirGrid::build_with(point, spheres, n, None, quick, bound),
         }
     }
 
@@ -49,6 +50,13 @@ impl PointGrid {
     #[cfg(test)]
     pub(crate) fn has_grid(&self) -> bool {
         self.grid.is_some()
+    }
+
+    /// The grid's cells a face side and the room it takes in the unit of its bound
+    /// (entries), if it has one.
+    #[cfg(test)]
+    pub(crate) fn size(&self) -> Option<(u32, usize)> {
+        self.grid.as_ref().map(|g| (g.resolution(), g.places()))
     }
 }
 

@@ -656,6 +656,63 @@ fn large_scenes_lose_no_hit_or_occluder() {
     assert!(shadows > 1500 && shadowed > 100, "{shadows} {shadowed}");
 }
 
+/// The lights' grids share one grid's bound: over 20,000 small balls one light gets
+/// its grid at the finest resolution, each of 64 lights a coarser one, and 1,024
+/// lights none (their shadow rays walk the hierarchy); every shadow factor, from
+/// either, equals brute force.
+#[test]
+fn many_lights_share_one_grid_s_bound_and_lose_no_occluder() {
+    let scene = crate::scene::many_scene(20_000);
+    let spheres = &scene.spheres;
+    let ring = |count: usize| -> Vec<DVec3> {
+        (0..count)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / count as f64;
+                DVec3::new(60.0 * a.cos(), 40.0 + 20.0 * (i % 5) as f64, 60.0 * a.sin())
+            })
+            .collect()
+    };
+    let bound = super::super::dirgrid::most_entries(spheres.len());
+    let one = Spheres::new(spheres).with_light_grids(&ring(1));
+    assert_eq!(one.lights[0].size().map(|s| s.0), Some(256));
+    let some = Spheres::new(spheres).with_light_grids(&ring(64));
+    let sizes: Vec<(u32, usize)> = some.lights.iter().filter_map(|l| l.size()).collect();
+    assert_eq!(sizes.len(), 64, "every light keeps a grid");
+    assert!(sizes.iter().all(|&(n, _)| n < 256), "{sizes:?}");
+    assert!(sizes.iter().map(|s| s.1).sum::<usize>() <= bound);
+    let many = Spheres::new(spheres).with_light_grids(&ring(1024));
+    assert!(many.lights.iter().all(|l| !l.has_grid()));
+
+    let eye = DVec3::new(0.0, 18.0, 60.0);
+    let eye_grid = one.eye_grid(eye, None);
+    let (mut shadows, mut shadowed) = (0, 0);
+    for (i, dir) in even_directions(4000).into_iter().enumerate() {
+        let dir = dir.as_vec3().normalize();
+        let Some(hit) = one.closest_from_eye(&eye_grid, dir) else {
+            continue;
+        };
+        for (set, light) in [(&some, i % 64), (&many, i % 1024)] {
+            let position = set.lights[light].centre();
+            let (sq, dist, Some(want)) = shadow_case(spheres, &hit, position) else {
+                continue;
+            };
+            shadows += 1;
+            shadowed += u32::from(want < 1.0);
+            let got = set.shadow_to_light(&sq, dist, light);
+            assert!(
+                (f64::from(got) - want).abs() <= 1e-5,
+                "ray {i}, light {light}: shadow {got}, f64 says {want}"
+            );
+        }
+    }
+    println!(
+        "many lights: 64 grids of {:?} (cells a side, room), {shadows} shadow rays \
+         ({shadowed} shadowed)",
+        sizes[0]
+    );
+    assert!(shadows > 1000 && shadowed > 50, "{shadows} {shadowed}");
+}
+
 /// Balls crowding the eye and the light, each seen over a seventh of the sky from
 /// both, would fill even their coarsest grids past the bound: the build gives them
 /// none, and the eye's and the light's queries walk the hierarchy instead, losing
