@@ -3,6 +3,8 @@
 //! parent), traversed near child first. It only proposes candidates; the exact
 //! sphere tests decide.
 
+use std::ops::ControlFlow;
+
 use arrayvec::ArrayVec;
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
@@ -153,8 +155,13 @@ impl Bvh {
 
     /// Calls `visit(slot)` for every item (`items()[slot]`) of every leaf whose box
     /// overlaps the box `[min, max]`: each item whose own box overlaps it, and the
-    /// others of its leaf.
-    pub(super) fn overlapping(&self, min: Vec3A, max: Vec3A, mut visit: impl FnMut(u32)) {
+    /// others of its leaf; until `visit` breaks.
+    pub(super) fn overlapping(
+        &self,
+        min: Vec3A,
+        max: Vec3A,
+        mut visit: impl FnMut(u32) -> ControlFlow<()>,
+    ) {
         if self.nodes.is_empty() {
             return;
         }
@@ -180,8 +187,8 @@ impl Bvh {
                 let (child, count) = (n.child[lane], u32::from(n.count[lane]));
                 if count == 0 {
                     stack.push(child);
-                } else {
-                    (child..child + count).for_each(&mut visit);
+                } else if (child..child + count).try_for_each(&mut visit).is_break() {
+                    return;
                 }
             }
         }
@@ -920,7 +927,10 @@ mod tests {
         for q in 0..600 {
             let query = random_box(100.0, if q % 3 == 0 { 0.5 } else { 8.0 });
             let mut got = Vec::new();
-            bvh.overlapping(query.min, query.max, |slot| got.push(slot as usize));
+            bvh.overlapping(query.min, query.max, |slot| {
+                got.push(slot as usize);
+                ControlFlow::Continue(())
+            });
             got.sort_unstable();
             let mut expected: Vec<usize> = leaves
                 .iter()
@@ -942,12 +952,26 @@ mod tests {
             leaf_mates += got.len();
         }
         leaf_mates -= own;
+        // A visit that breaks stops the query.
+        let mut visits = 0;
+        bvh.overlapping(Vec3A::splat(-1e30), Vec3A::splat(1e30), |_| {
+            visits += 1;
+            if visits == 10 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
+        assert_eq!(visits, 10);
         println!("{own} overlapping boxes listed, {leaf_mates} leaf-mates with them");
         assert!(own > 1000 && leaf_mates > 0, "{own} {leaf_mates}");
 
         let empty = Bvh::build(0, |_| unreachable!());
         let mut calls = 0;
-        empty.overlapping(Vec3A::splat(-1e30), Vec3A::splat(1e30), |_| calls += 1);
+        empty.overlapping(Vec3A::splat(-1e30), Vec3A::splat(1e30), |_| {
+            calls += 1;
+            ControlFlow::Continue(())
+        });
         empty.traverse(Vec3::ZERO, Vec3::ONE, f32::INFINITY, |_, _| {
             calls += 1;
             None

@@ -497,7 +497,9 @@ fn rays_inside_a_sphere_meet_what_brute_force_meets() {
             // A sphere's list holds the spheres that overlap or touch it, and no
             // other (by a margin of 10⁻⁵ of the two radii).
             for (s, sphere) in spheres.iter().enumerate() {
-                let list = with_lists.overlapping(s as u32);
+                let list = with_lists
+                    .overlapping(s as u32, usize::MAX)
+                    .expect("no bound");
                 for (k, other) in spheres.iter().enumerate() {
                     let sum = sphere.radius + other.radius;
                     let gap = (other.center - sphere.center).length() - sum;

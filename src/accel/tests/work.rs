@@ -65,10 +65,38 @@ fn a_ray_inside_a_ball_tests_only_its_far_side() {
     );
     assert_eq!(tests, 1);
     assert_eq!(
-        set.inside[0].get().map(|list| &list[..]),
-        Some(&[1][..]),
+        set.inside[0].get().map(|list| list.as_deref()),
+        Some(Some(&[1][..])),
         "a ball of a small scene keeps its list of overlapping balls"
     );
+}
+
+/// A ball overlapped by 16 others keeps their list; by 17, none, and a ray inside it
+/// walks the hierarchy: the same hit either way (the small ball inside, on its path).
+#[test]
+fn a_ball_overlapped_by_many_keeps_no_list() {
+    for (ring, listed) in [(15, true), (16, false)] {
+        // Ball 0, ball 1 inside it on the x axis, and `ring` balls on its surface
+        // around the x axis, off the ray's path.
+        let mut spheres = vec![
+            Sphere::new(DVec3::ZERO, 10.0),
+            Sphere::new(DVec3::new(5.0, 0.0, 0.0), 0.5),
+        ];
+        spheres.extend((0..ring).map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / f64::from(ring);
+            Sphere::new(DVec3::new(0.0, a.cos(), a.sin()) * 10.0, 0.5)
+        }));
+        let set = Spheres::new(&spheres);
+        let q = query(
+            DVec3::new(-10.0, 0.0, 0.0),
+            DVec3::X,
+            Some((0, Side::Inward)),
+        );
+        let hit = set.closest(&q).expect("ball 1 ahead");
+        assert_eq!((hit.sphere, hit.point), (1, DVec3::new(4.5, 0.0, 0.0)));
+        let list = set.inside[0].get().expect("worked out").as_deref();
+        assert_eq!(list.map(<[u32]>::len), listed.then_some(ring as usize + 1));
+    }
 }
 
 /// A shadow query from the top of ball 0 to a light inside it, leaving ball 0 by its
@@ -213,8 +241,8 @@ fn overlap_lists_keep_no_sphere_beyond_their_allowance() {
             apart(0.5 * allowance),
         ]);
         assert_eq!(
-            &set.overlapping(1)[..],
-            &[2, 3, 4],
+            set.overlapping(1, usize::MAX).as_deref(),
+            Some(&[2, 3, 4][..]),
             "around {centre} radius {r}"
         );
     }
