@@ -355,6 +355,33 @@ pub fn stress_scenes() -> Vec<Stress> {
             s
         },
     );
+    push(
+        "clump",
+        "A clump of 120 balls of radius 0.5 whose centres lie within 0.5 of a point, so that \
+         each overlaps every other, a third mirrors and most of the rest glass, on the \
+         ground: rays inside a ball that overlaps more than 16 others walk the hierarchy \
+         instead of testing a list of them.",
+        {
+            let mut s = hw3();
+            let mut seq = Seq(11);
+            let ground = s.spheres[0];
+            s.spheres = std::iter::once(ground)
+                .chain((0..120).map(|k| {
+                    let offset = loop {
+                        let v = DVec3::new(seq.next(), seq.next(), seq.next()) * 2.0 - 1.0;
+                        if v.length_squared() <= 1.0 {
+                            break v;
+                        }
+                    };
+                    let c = DVec3::new(0.0, 0.3, -1.4) + offset * 0.5;
+                    let color = [0.3 + 0.5 * (k % 2) as f64, 0.6, 0.8 - 0.4 * (k % 3) as f64];
+                    let (reflect, transmit) = [(0.9, 0.0), (0.1, 0.9), (0.0, 0.8)][k % 3];
+                    ball(c.to_array(), 0.5, color, reflect, transmit)
+                }))
+                .collect();
+            s
+        },
+    );
     out
 }
 
