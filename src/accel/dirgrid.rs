@@ -69,10 +69,15 @@ pub(super) fn most_entries_each(spheres: usize, grids: usize) -> usize {
     most_entries(spheres) / grids.max(1)
 }
 
+/// The cells of a grid of `n` cells a face side.
+fn cell_count(n: u32) -> usize {
+    6 * (n as usize) * (n as usize)
+}
+
 /// The room a grid of `n` cells a side and entries of `entry_bytes` takes besides
-/// its entries, in entries: its cells' offsets (4 bytes each).
+/// its entries, in entries: its cells' offsets (4 bytes each, and one past the last).
 fn cell_places(n: u32, entry_bytes: usize) -> usize {
-    (6 * (n as usize) * (n as usize) + 1) * size_of::<u32>() / entry_bytes
+    (cell_count(n) + 1) * size_of::<u32>() / entry_bytes
 }
 
 /// The coarsest grid a crowded scene falls back to, in cells a face side: coarser
@@ -87,7 +92,7 @@ const COARSEST: u32 = 32;
 /// slower to walk than the hierarchy.)
 fn coarser(n: u32, spheres: usize) -> impl Iterator<Item = u32> {
     std::iter::successors(Some(n / 2), |m| Some(m / 2))
-        .take_while(move |&m| m >= COARSEST && 6 * (m as usize) * (m as usize) >= spheres)
+        .take_while(move |&m| m >= COARSEST && cell_count(m) >= spheres)
 }
 
 /// At most as many entries as a grid of `n` cells a side around `centre` lists for
@@ -323,7 +328,7 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         n: u32,
         bound: usize,
     ) -> Option<DirGrid<T>> {
-        let faces = 6 * (n as usize) * (n as usize);
+        let faces = cell_count(n);
         let cones = CellCones::shared(n);
         // Each sphere's cells, in runs of spheres on rayon's threads; the runs come
         // back in order, so the pairs stay nearest first. A pair names the sphere by
