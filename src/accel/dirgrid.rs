@@ -45,12 +45,14 @@ pub(super) struct Listed<T> {
 /// Spheres a unit of parallel work of the build: enough to outweigh its overhead.
 const SPHERES_PER_RUN: usize = 2048;
 
-/// The most entries a grid holds: [`ENTRIES_ANY`] and this many a sphere. A sphere a
-/// few of its radii from the centre is seen in a large part of the cells, so a crowd
-/// of them would list millions of entries each (20,000 balls of radius 1 around a
-/// light at 2.5: 330 million, 10 GB); past the bound the build takes a coarser grid,
-/// and past the coarsest none (see [`DirGrid::build_with`]). Scenes of small spheres
-/// stay far below it (a million of them list 3.9 million entries around a light).
+/// The most entries a grid holds, its cells' offsets counted among them
+/// ([`cell_places`]): [`ENTRIES_ANY`] and this many a sphere. A sphere a few of its
+/// radii from the centre is seen in a large part of the cells, so a crowd of them
+/// would list millions of entries each (20,000 balls of radius 1 around a light at
+/// 2.5: 330 million, 10 GB); past the bound the build takes a coarser grid, and past
+/// the coarsest it may ([`coarser`]) none (see [`DirGrid::build_with`]). Scenes of
+/// small spheres stay far below it (a million of them list 3.9 million entries around
+/// a light).
 const ENTRIES_PER_SPHERE: usize = 8;
 /// See [`ENTRIES_PER_SPHERE`].
 const ENTRIES_ANY: usize = 1 << 22;
