@@ -4,7 +4,7 @@
 //!
 //! [`render()`] takes a scene and resolved [`Settings`]; the submodules are its steps:
 //! `bands` (rows over threads), `film` (where samples land), `adaptive`
-//! (anti-aliasing where it matters), [`resolve`] (sums to finite pixel values) and
+//! (anti-aliasing where it matters), [`resolve()`] (sums to finite pixel values) and
 //! `progressive` (sums kept between the passes of a progressive render).
 
 mod adaptive;

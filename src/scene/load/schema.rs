@@ -22,7 +22,7 @@ pub(super) struct FileScene {
     pub(super) animation: Option<Spanned<FileAnimation>>,
 }
 
-/// A batch of `[[sphere]]` tables of a run (see [`SphereRun`]) parsed on its own.
+/// A batch of `[[sphere]]` tables of a run (see [`super::streaming::SphereRun`]) parsed on its own.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct FileSphereTable {
