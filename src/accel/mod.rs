@@ -97,11 +97,6 @@ fn eye_resolution(spheres: usize) -> u32 {
     }
 }
 
-/// The bound of each light's grid: the lights share one grid's.
-fn light_bound(spheres: &[(DVec3, f64)], lights: &[DVec3]) -> usize {
-    dirgrid::most_entries_each(spheres.len(), lights.len())
-}
-
 /// Cells per face of the lights' directional grids. A render pays for every cell once
 /// (its offset is fresh memory, its cone worked out once per process), which a warm
 /// frame does not show: hw3's shadow rays are as fast with 64 cells as with 128, and
@@ -231,7 +226,8 @@ impl Spheres {
     #[cfg(test)]
     pub(crate) fn with_light_grids(mut self, lights: &[DVec3]) -> Self {
         let list = self.centres_and_radii();
-        let (n, bound) = (grid_resolution(list.len()), light_bound(&list, lights));
+        let n = grid_resolution(list.len());
+        let bound = dirgrid::most_entries_each(list.len(), lights.len());
         self.lights = lights
             .par_iter()
             .map(|&p| PointGrid::build(p, &list, n, bound))
@@ -249,7 +245,8 @@ impl Spheres {
         view: Option<&ViewPyramid>,
     ) -> (Spheres, EyeGrid) {
         let list: Vec<(DVec3, f64)> = spheres.par_iter().map(|s| (s.center, s.radius)).collect();
-        let (n, bound) = (grid_resolution(list.len()), light_bound(&list, lights));
+        let n = grid_resolution(list.len());
+        let bound = dirgrid::most_entries_each(list.len(), lights.len());
         let eye_n = eye_resolution(list.len());
         let (base, (eye_grid, lights)) = rayon::join(
             || Spheres::new(spheres),
@@ -438,7 +435,6 @@ impl Spheres {
         let (c, r) = (self.center[s], self.radius[s]);
         let bounds = sphere_box(c, r);
         let mut list = Vec::new();
-        let mut too_many = false;
         self.bvh.overlapping(bounds.min, bounds.max, |slot| {
             let k = self.leaf[slot as usize].k as usize;
             let (ck, rk) = (self.center[k], self.radius[k]);
@@ -446,19 +442,16 @@ impl Spheres {
                 (r + rk) * (1.0 + 1e-6) + 1e-9 * (c.abs().max_element() + ck.abs().max_element());
             if k != s && (ck - c).length() <= reach {
                 list.push(k as u32);
-                too_many = list.len() > most;
+                if list.len() > most {
+                    return ControlFlow::Break(());
+                }
             }
-            if too_many {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
+            ControlFlow::Continue(())
         });
-        if too_many {
-            return None;
-        }
-        list.sort_unstable();
-        Some(list.into_boxed_slice())
+        (list.len() <= most).then(|| {
+            list.sort_unstable();
+            list.into_boxed_slice()
+        })
     }
 
     /// Sphere `k`'s outward normal where the shadow segment of length `dist` first
