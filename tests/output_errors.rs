@@ -182,8 +182,10 @@ fn an_interrupted_render_leaves_no_file() {
 
 /// A render written to a device node that behaves like `/dev/full` (char 1,7,
 /// made with mknod under the name `out.png` in a temporary folder, so that the real
-/// /dev/full is never at risk): exit 1 with one line, the node left as it was, no other
-/// file.
+/// /dev/full is never at risk): exit 1 with one line that gives the system's reason,
+/// the node left as it was, no other file. A small image fails when its buffer is
+/// written out; a large one (2,000 × 2,000) fails inside the encoder, which writes
+/// into the file as it goes: the reason is the same, not the encoder's.
 #[test]
 fn writing_to_a_full_device_fails_and_leaves_it_alone() {
     use std::os::unix::fs::FileTypeExt;
@@ -203,20 +205,28 @@ fn writing_to_a_full_device_fails_and_leaves_it_alone() {
         );
         return;
     }
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .args(["render", "--width", "32", "--height", "18", "--quiet", "-o"])
-        .arg(&node)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    println!("full device: {:?} {stderr:?}", out.status.code());
-    let still_device =
-        std::fs::symlink_metadata(&node).is_ok_and(|m| m.file_type().is_char_device());
-    let others = std::fs::read_dir(dir.path()).unwrap().count() - 1;
-    assert!(still_device, "the device node was replaced");
-    assert_eq!(others, 0, "files left beside it");
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    for (width, height) in [("32", "18"), ("2000", "2000")] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_whitted"))
+            .args([
+                "render", "--width", width, "--height", height, "--quiet", "-o",
+            ])
+            .arg(&node)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        println!(
+            "full device, {width}x{height}: {:?} {stderr:?}",
+            out.status.code()
+        );
+        let still_device =
+            std::fs::symlink_metadata(&node).is_ok_and(|m| m.file_type().is_char_device());
+        let others = std::fs::read_dir(dir.path()).unwrap().count() - 1;
+        assert!(still_device, "the device node was replaced");
+        assert_eq!(others, 0, "files left beside it");
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains("No space left on device"), "{stderr}");
+    }
 }
 
 /// Sends `signal` (a name for kill(1): TERM, INT) to process `pid`.

@@ -289,14 +289,44 @@ pub fn encode(frame: &Frame, format: Format, encoding: Encoding) -> Result<Vec<u
     Ok(out)
 }
 
-/// Saves 8-bit RGB (top row first) to `path` in `format` (not EXR), atomically.
+/// Saves 8-bit RGB (top row first) to `path` in `format` (not EXR), atomically. The
+/// encoder writes into the file as it goes, so the encoded image is never held whole
+/// in memory (a plain PPM's text is about four times the pixels' bytes).
 pub fn save_rgb8(image: &RgbImage, path: &Path, format: Format) -> Result<(), SaveError> {
-    let mut bytes = Vec::new();
-    encode_rgb8(image, format, &mut bytes).map_err(|e| SaveError {
+    let mut file = AtomicFile::create(path)?;
+    let (encoded, written) = {
+        let mut out = FlushAtEnd(std::io::BufWriter::with_capacity(1 << 16, &mut file));
+        let encoded = encode_rgb8(image, format, &mut out);
+        (
+            encoded,
+            out.0.into_inner().map(drop).map_err(|e| e.into_error()),
+        )
+    };
+    let error = |message: String| SaveError {
         path: path.display().to_string(),
-        message: format!("cannot encode: {e}"),
-    })?;
-    write_atomically(path, &bytes)
+        message,
+    };
+    match encoded {
+        // The file's own errors (a full disk) are not the encoder's.
+        Err(EncodeError::Image(image::ImageError::IoError(e))) => Err(error(e.to_string())),
+        Err(e) => Err(error(format!("cannot encode: {e}"))),
+        Ok(()) => written.map_err(|e| error(e.to_string())),
+    }?;
+    file.commit()
+}
+
+/// A buffered writer whose `flush` waits for the end: the PNM encoder flushes after
+/// every line of its text, which would make a system call of every 70 bytes.
+struct FlushAtEnd<W: Write>(std::io::BufWriter<W>);
+
+impl<W: Write> Write for FlushAtEnd<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 /// Saves the frame to `path` in `format`, its bytes in `encoding`, atomically.
@@ -306,7 +336,10 @@ pub fn save(
     format: Format,
     encoding: Encoding,
 ) -> Result<(), SaveError> {
-    let bytes = encode(frame, format, encoding).map_err(|e| SaveError {
+    if format != Format::Exr {
+        return save_rgb8(&to_rgb8(frame, encoding), path, format);
+    }
+    let bytes = exr_bytes(&to_rgb32f(frame), None).map_err(|e| SaveError {
         path: path.display().to_string(),
         message: format!("cannot encode: {e}"),
     })?;
