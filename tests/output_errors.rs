@@ -35,7 +35,8 @@ fn in_mount_namespace(script: &str) -> Option<std::process::Output> {
 }
 
 /// A full disk (a 64 KiB tmpfs) and a read-only folder (a read-only tmpfs): exit 1,
-/// one error line, and the folder is left empty.
+/// one error line, and the folder is left empty; for an EXR, which is encoded into
+/// its temporary file, and for a PPM and a PNG.
 #[test]
 fn a_full_disk_or_a_read_only_folder_leaves_no_file() {
     let dir = tempfile::tempdir().unwrap();
@@ -45,9 +46,12 @@ fn a_full_disk_or_a_read_only_folder_leaves_no_file() {
         ("full disk", "size=64k"),
         ("read-only folder", "ro,size=64k"),
     ] {
-        // A plain PPM of 320x180 is about 500 KB: it cannot fit in 64 KiB.
+        // A plain PPM of 320x180 is about 500 KB and an EXR 700 KB: neither fits in
+        // 64 KiB. The EXR is encoded into the temporary file as it goes.
         let script = format!(
             "mount -t tmpfs -o {options} tmpfs '{mnt}' || exit 99; \
+             '{bin}' render --width 320 --height 180 --quiet -o '{mnt}/out.exr'; \
+             echo \"rc=$?\"; \
              '{bin}' render --width 320 --height 180 --quiet -o '{mnt}/out.ppm' -o '{mnt}/out.png'; \
              echo \"rc=$?\"; ls -A '{mnt}'"
         );
@@ -71,11 +75,14 @@ fn a_full_disk_or_a_read_only_folder_leaves_no_file() {
             continue;
         }
         let mut lines = stdout.lines();
+        assert_eq!(lines.next(), Some("rc=1"), "{what}: exit status (EXR)");
         assert_eq!(lines.next(), Some("rc=1"), "{what}: exit status");
         assert_eq!(lines.next(), None, "{what}: files left behind: {stdout}");
         let errors: Vec<&str> = stderr.lines().collect();
-        assert_eq!(errors.len(), 1, "{what}: one error line: {stderr}");
-        assert!(errors[0].starts_with("whitted: error: "), "{stderr}");
+        assert_eq!(errors.len(), 2, "{what}: one error line each: {stderr}");
+        for error in errors {
+            assert!(error.starts_with("whitted: error: "), "{stderr}");
+        }
     }
     // A file-size limit (RLIMIT_FSIZE, SIGXFSZ ignored) fails writes like a full disk,
     // without privileges.

@@ -186,6 +186,16 @@ impl AtomicFile {
         save_error(&self.path, message)
     }
 
+    /// The temporary file, for an encoder that seeks (EXR writes its table of chunk
+    /// offsets last); `None` when the target is written in place (a device or a FIFO,
+    /// which may not seek).
+    pub fn temporary_file(&mut self) -> Option<&mut File> {
+        match &mut self.sink {
+            Sink::Temp(temp, _) => Some(temp.as_file_mut()),
+            Sink::InPlace(_) => None,
+        }
+    }
+
     /// Fails if the temporary file has been removed (its folder deleted, say): what
     /// is written to it from then on would be lost, so a long writer stops early.
     pub fn check_still_there(&self) -> Result<(), SaveError> {

@@ -6,7 +6,7 @@
 mod animated;
 mod atomic;
 
-use std::io::{BufRead, Cursor, Seek, SeekFrom, Write};
+use std::io::{BufRead, BufWriter, Cursor, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use image::codecs::bmp::BmpEncoder;
@@ -283,7 +283,7 @@ pub fn encode_rgb8(
 pub fn encode(frame: &Frame, format: Format, encoding: Encoding) -> Result<Vec<u8>, EncodeError> {
     let mut out = Vec::new();
     match format {
-        Format::Exr => out = exr_bytes(&to_rgb32f(frame), None)?,
+        Format::Exr => out = exr_bytes(frame, None)?,
         _ => encode_rgb8(&to_rgb8(frame, encoding), format, &mut out)?,
     }
     Ok(out)
@@ -295,29 +295,21 @@ pub fn encode(frame: &Frame, format: Format, encoding: Encoding) -> Result<Vec<u
 pub fn save_rgb8(image: &RgbImage, path: &Path, format: Format) -> Result<(), SaveError> {
     let mut file = AtomicFile::create(path)?;
     let (encoded, written) = {
-        let mut out = FlushAtEnd(std::io::BufWriter::with_capacity(1 << 16, &mut file));
+        let mut out = FlushAtEnd(BufWriter::with_capacity(1 << 16, &mut file));
         let encoded = encode_rgb8(image, format, &mut out);
         (
             encoded,
             out.0.into_inner().map(drop).map_err(|e| e.into_error()),
         )
     };
-    let error = |message: String| SaveError {
-        path: path.display().to_string(),
-        message,
-    };
-    match encoded {
-        // The file's own errors (a full disk) are not the encoder's.
-        Err(EncodeError::Image(image::ImageError::IoError(e))) => Err(error(e.to_string())),
-        Err(e) => Err(error(format!("cannot encode: {e}"))),
-        Ok(()) => written.map_err(|e| error(e.to_string())),
-    }?;
+    encoded.map_err(|e| encode_failure(path, e))?;
+    written.map_err(|e| io_failure(path, e))?;
     file.commit()
 }
 
 /// A buffered writer whose `flush` waits for the end: the PNM encoder flushes after
 /// every line of its text, which would make a system call of every 70 bytes.
-struct FlushAtEnd<W: Write>(std::io::BufWriter<W>);
+struct FlushAtEnd<W: Write>(BufWriter<W>);
 
 impl<W: Write> Write for FlushAtEnd<W> {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
@@ -329,7 +321,9 @@ impl<W: Write> Write for FlushAtEnd<W> {
     }
 }
 
-/// Saves the frame to `path` in `format`, its bytes in `encoding`, atomically.
+/// Saves the frame to `path` in `format`, its bytes in `encoding`, atomically. EXR is
+/// encoded into the temporary file as it goes too, unless the target is written in
+/// place (a device or a FIFO cannot seek back to the table of chunk offsets).
 pub fn save(
     frame: &Frame,
     path: &Path,
@@ -339,26 +333,63 @@ pub fn save(
     if format != Format::Exr {
         return save_rgb8(&to_rgb8(frame, encoding), path, format);
     }
-    let bytes = exr_bytes(&to_rgb32f(frame), None).map_err(|e| SaveError {
-        path: path.display().to_string(),
-        message: format!("cannot encode: {e}"),
-    })?;
-    write_atomically(path, &bytes)
+    let mut file = AtomicFile::create(path)?;
+    if let Some(temp) = file.temporary_file() {
+        let mut out = BufWriter::with_capacity(1 << 16, temp);
+        write_exr(frame, None, &mut out).map_err(|e| encode_failure(path, e))?;
+        out.flush().map_err(|e| io_failure(path, e))?;
+    } else {
+        let bytes = exr_bytes(frame, None).map_err(|e| encode_failure(path, e))?;
+        file.write_all(&bytes).map_err(|e| io_failure(path, e))?;
+    }
+    file.commit()
 }
 
-/// Linear RGB (top row first) as OpenEXR, through the `exr` crate: the whole image, or
-/// with `part`, a part whose data window sits at its place in the whole image's
-/// display window and whose header records the placement (see [`parts`]). Written on
-/// one thread, so the chunks come in order and the same pixels give the same bytes.
+/// Why `path` was not written: the file's own errors (a full disk) in the system's
+/// words, the encoder's as such.
+fn encode_failure(path: &Path, e: EncodeError) -> SaveError {
+    match e {
+        EncodeError::Image(image::ImageError::IoError(e))
+        | EncodeError::Exr(exr::error::Error::Io(e)) => io_failure(path, e),
+        e => SaveError {
+            path: path.display().to_string(),
+            message: format!("cannot encode: {e}"),
+        },
+    }
+}
+
+fn io_failure(path: &Path, e: std::io::Error) -> SaveError {
+    SaveError {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// The frame's linear RGB as OpenEXR (top row first), in memory (see [`write_exr`]).
 pub(crate) fn exr_bytes(
-    image: &Rgb32FImage,
+    frame: &Frame,
     part: Option<&parts::Placement>,
 ) -> Result<Vec<u8>, EncodeError> {
+    let mut out = Cursor::new(Vec::new());
+    write_exr(frame, part, &mut out)?;
+    Ok(out.into_inner())
+}
+
+/// The frame's linear RGB as OpenEXR (top row first) into `out`, through the `exr`
+/// crate, which reads the pixels from the frame as it encodes them: the whole image,
+/// or with `part`, a part whose data window sits at its place in the whole image's
+/// display window and whose header records the placement (see [`parts`]). Written on
+/// one thread, so the chunks come in order and the same pixels give the same bytes.
+pub(crate) fn write_exr(
+    frame: &Frame,
+    part: Option<&parts::Placement>,
+    out: impl Write + Seek,
+) -> Result<(), EncodeError> {
     use exr::meta::attribute::{AttributeValue, IntegerBounds, Text};
     use exr::prelude::{
         Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage,
     };
-    let size = (image.width() as usize, image.height() as usize);
+    let (width, height) = (frame.width as usize, frame.height as usize);
     let mut attributes = LayerAttributes::default();
     if let Some(p) = part {
         attributes.layer_position = Vec2(p.region.x as i32, p.region.y as i32);
@@ -367,17 +398,21 @@ pub(crate) fn exr_bytes(
             AttributeValue::Text(Text::from(p.to_string().as_str())),
         );
     }
+    // The frame's rows run from the bottom; the file's from the top.
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
-        let px = image.get_pixel(p.x() as u32, p.y() as u32);
-        (px[0], px[1], px[2])
+        let px = frame.pixels[(height - 1 - p.y()) * width + p.x()];
+        (px.x, px.y, px.z)
     });
-    let mut exr_image =
-        Image::from_layer(Layer::new(size, attributes, Encoding::default(), channels));
+    let mut exr_image = Image::from_layer(Layer::new(
+        (width, height),
+        attributes,
+        Encoding::default(),
+        channels,
+    ));
     if let Some(p) = part {
         exr_image.attributes.display_window =
             IntegerBounds::new((0, 0), (p.width as usize, p.height as usize));
     }
-    let mut out = Cursor::new(Vec::new());
-    exr_image.write().non_parallel().to_buffered(&mut out)?;
-    Ok(out.into_inner())
+    exr_image.write().non_parallel().to_buffered(out)?;
+    Ok(())
 }

@@ -14,9 +14,7 @@ use std::str::FromStr;
 use glam::Vec3;
 use image::{Rgb32FImage, RgbImage};
 
-use super::{
-    bytes_left, check_holds, exr_bytes, to_rgb32f, to_rgb8, write_atomically, Format, SaveError,
-};
+use super::{bytes_left, check_holds, exr_bytes, to_rgb8, write_atomically, Format, SaveError};
 use crate::limits;
 use crate::render::Frame;
 use crate::scene::{to_toml, Scene};
@@ -164,7 +162,7 @@ pub fn encode_part(
 ) -> Result<Vec<u8>, String> {
     match format {
         Format::Png => png_part(&to_rgb8(frame, encoding), placement),
-        Format::Exr => exr_bytes(&to_rgb32f(frame), Some(placement)).map_err(|e| e.to_string()),
+        Format::Exr => exr_bytes(frame, Some(placement)).map_err(|e| e.to_string()),
         _ => return Err("a part records its place in the image only in PNG and EXR files".into()),
     }
     .map_err(|e| format!("cannot encode: {e}"))
