@@ -2,7 +2,7 @@
 # Builds whitted with profile-guided optimisation: an instrumented build runs the
 # training below, and a second build lays out and inlines the hot loops by how often
 # their branches ran (`-Cprofile-use`). The images are the same bytes; the time of a
-# render is 4-7% lower (docs/speed.md). The profile is made from the source as it is,
+# render is 3-8% lower (docs/speed.md). The profile is made from the source as it is,
 # so it is never stale; the default build (`cargo build --release`) does not use one,
 # which keeps it portable and free of a binary file to maintain.
 #
