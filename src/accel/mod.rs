@@ -109,6 +109,17 @@ fn grid_resolution(spheres: usize) -> u32 {
     }
 }
 
+/// A directional grid around each light for spheres `(centre, radius)`: the lights
+/// share one grid's bound ([`dirgrid::most_entries_each`]).
+fn light_grids(spheres: &[(DVec3, f64)], lights: &[DVec3]) -> Vec<PointGrid> {
+    let n = grid_resolution(spheres.len());
+    let bound = dirgrid::most_entries_each(spheres.len(), lights.len());
+    lights
+        .par_iter()
+        .map(|&p| PointGrid::build(p, spheres, n, bound))
+        .collect()
+}
+
 /// The `f32` centre and radius of the quick test, the radius widened to cover the
 /// centre's rounding.
 fn quick_sphere(c: DVec3, r: f64) -> Vec4 {
@@ -225,13 +236,7 @@ impl Spheres {
     /// part at a time with it; the tracer builds all at once ([`Spheres::build_for_view`]).
     #[cfg(test)]
     pub(crate) fn with_light_grids(mut self, lights: &[DVec3]) -> Self {
-        let list = self.centres_and_radii();
-        let n = grid_resolution(list.len());
-        let bound = dirgrid::most_entries_each(list.len(), lights.len());
-        self.lights = lights
-            .par_iter()
-            .map(|&p| PointGrid::build(p, &list, n, bound))
-            .collect();
+        self.lights = light_grids(&self.centres_and_radii(), lights);
         self
     }
 
@@ -245,20 +250,13 @@ impl Spheres {
         view: Option<&ViewPyramid>,
     ) -> (Spheres, EyeGrid) {
         let list: Vec<(DVec3, f64)> = spheres.par_iter().map(|s| (s.center, s.radius)).collect();
-        let n = grid_resolution(list.len());
-        let bound = dirgrid::most_entries_each(list.len(), lights.len());
         let eye_n = eye_resolution(list.len());
         let (base, (eye_grid, lights)) = rayon::join(
             || Spheres::new(spheres),
             || {
                 rayon::join(
                     || DirGrid::build(eye, &list, eye_n, view),
-                    || {
-                        lights
-                            .par_iter()
-                            .map(|&p| PointGrid::build(p, &list, n, bound))
-                            .collect()
-                    },
+                    || light_grids(&list, lights),
                 )
             },
         );

@@ -294,22 +294,22 @@ pub fn encode(frame: &Frame, format: Format, encoding: Encoding) -> Result<Vec<u
 /// in memory (a plain PPM's text is about four times the pixels' bytes).
 pub fn save_rgb8(image: &RgbImage, path: &Path, format: Format) -> Result<(), SaveError> {
     let mut file = AtomicFile::create(path)?;
-    let (encoded, written) = {
-        let mut out = FlushAtEnd(BufWriter::with_capacity(1 << 16, &mut file));
-        let encoded = encode_rgb8(image, format, &mut out);
-        (
-            encoded,
-            out.0.into_inner().map(drop).map_err(|e| e.into_error()),
-        )
-    };
-    encoded.map_err(|e| encode_failure(path, e))?;
-    written.map_err(|e| io_failure(path, e))?;
+    let mut out = FlushAtEnd(BufWriter::with_capacity(1 << 16, &mut file));
+    encode_rgb8(image, format, &mut out).map_err(|e| encode_failure(path, e))?;
+    out.finish().map_err(|e| io_failure(path, e))?;
     file.commit()
 }
 
 /// A buffered writer whose `flush` waits for the end: the PNM encoder flushes after
 /// every line of its text, which would make a system call of every 70 bytes.
 struct FlushAtEnd<W: Write>(BufWriter<W>);
+
+impl<W: Write> FlushAtEnd<W> {
+    /// Writes out what the buffer holds.
+    fn finish(self) -> std::io::Result<()> {
+        self.0.into_inner().map(drop).map_err(|e| e.into_error())
+    }
+}
 
 impl<W: Write> Write for FlushAtEnd<W> {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
