@@ -199,6 +199,30 @@ fn the_near_quick_test_passes_every_ray_within_its_offset_and_rejects_clear_miss
     );
 }
 
+/// The shadow rays' line test keeps its error bound relative to the distance, not to
+/// its square: from a light 100 away, a line 5% of a radius outside a ball of radius
+/// 0.2 is rejected, one 5% inside passes (a slack of 2⁻¹⁷·|f|² on the squared
+/// distance passed lines up to 1.7 radii out: an exact test each).
+#[test]
+fn the_near_quick_test_rejects_lines_just_outside_a_small_ball_far_away() {
+    let (light, r) = (DVec3::new(-30.0, 60.0, 40.0), 0.2);
+    for k in 0..16 {
+        let angle = f64::from(k) * 0.4;
+        let towards = DVec3::new(angle.cos(), -1.5, angle.sin()).normalize();
+        let across = towards.cross(DVec3::Y).normalize();
+        let centre = light + towards * 100.0;
+        let quick = PointQuick::new(light, centre, quick_sphere(centre, r));
+        for (out, passes) in [(1.05, false), (0.95, true)] {
+            let d = (towards * 100.0 + across * (out * r)).normalize().as_vec3();
+            assert_eq!(
+                quick.may_cross_near(d, 200.0, 0.0),
+                passes,
+                "line {out} radii from the centre, direction {towards}"
+            );
+        }
+    }
+}
+
 /// A sphere of radius 10^U(−3, 5) with its centre 10^U(−2, 5) from the origin.
 fn sphere() -> impl Strategy<Value = (DVec3, f64)> {
     (
