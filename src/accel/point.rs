@@ -22,19 +22,19 @@ use crate::model::Side;
 /// hierarchy.
 pub(crate) struct PointGrid {
     centre: DVec3,
-    grid: Option<DirGrid<PointQuick>>,
+    grid: Option<DirGrid<ShadowQuick>>,
 }
 
 /// An entry of a light's grid: a sphere, its nearest distance and its quick test's
 /// constants.
-type Candidate = Listed<PointQuick>;
+type Candidate = Listed<ShadowQuick>;
 
 impl PointGrid {
     /// The grid around `point` for spheres `(centre, radius)` within `bound`
-    /// ([`DirGrid::build_with`]), each entry with its sphere's [`PointQuick`] from
+    /// ([`DirGrid::build_with`]), each entry with its sphere's [`ShadowQuick`] from
     /// `point`.
     pub(super) fn build(point: DVec3, spheres: &[(DVec3, f64)], n: u32, bound: usize) -> PointGrid {
-        let quick = |c: DVec3, r: f64| PointQuick::new(point, c, quick_sphere(c, r));
+        let quick = |c: DVec3, r: f64| ShadowQuick::new(point, c, quick_sphere(c, r));
         PointGrid {
             centre: point,
             grid: DirGrid::build_with(point, spheres, n, None, quick, bound),
@@ -161,73 +161,87 @@ impl<'a> EyeRun<'a> {
 /// of the exact test (`eye − centre` and `|eye − centre|² − r²` in `f64`), side by side.
 #[derive(Clone, Copy)]
 struct EyeSphere {
-    quick: PointQuick,
+    quick: EyeQuick,
     f: DVec3,
     cterm: f64,
     radius: f64,
     inv_radius: f64,
 }
 
-/// One sphere as the quick tests of rays through a grid's point see it: the
-/// eye's ([`PointQuick::may_cross`]) and the shadow rays' ([`PointQuick::may_cross_near`]).
+/// One sphere as the quick test of primary rays sees it ([`EyeQuick::may_cross`]).
 #[derive(Clone, Copy)]
-pub(super) struct PointQuick {
-    /// `point − centre` in `f32`.
+pub(super) struct EyeQuick {
+    /// `eye − centre` in `f32`.
     f: Vec3,
-    /// The eye's test: a ray of unit direction `d` misses when `(f·d)²` is below this
-    /// (`|f|² − (f·d)²` is the line's squared distance from the centre), a bound
-    /// loosened by a slack relative to `|f|²`.
+    /// A ray of unit direction `d` misses when `(f·d)²` is below this: the closest
+    /// point of its line is then farther than the (widened) radius plus the slack.
     min_bp2: f32,
+    /// The crossings lie within this of `−f·d`: the widened radius and the slack of
+    /// `−f·d` itself.
+    reach: f32,
+}
+
+impl EyeQuick {
+    pub(super) fn new(eye: DVec3, centre: DVec3, quick: Vec4) -> Self {
+        // `may_cross`'s `|l|² > r² + slack` rewritten as `(f·d)² < |f|² − r² − slack`
+        // (`|l|² = |f|² − (f·d)²`): one dot product a candidate. The rewrite adds
+        // rounding of a few ε·|f|², far below the slack of 2⁻¹⁸·(r² + |f|²), and the
+        // bound is rounded down. (Looser than `ShadowQuick`'s for small balls far
+        // away, but the eye's candidates mostly pass and its exact test is short: the
+        // tighter test cost hw3 5% more instructions and gained nothing at a million.)
+        let f = (eye - centre).as_vec3();
+        let (w, ff) = (f64::from(quick.w), f64::from(f.dot(f)));
+        let slack = f64::from(QUICK_SLACK) * (w * w + ff);
+        let min_bp2 = round_down(ff - w * w - 2.0 * slack);
+        let ff = f.dot(f);
+        let reach = quick.w + QUICK_SLACK * (ff.sqrt() + quick.w);
+        EyeQuick { f, min_bp2, reach }
+    }
+
+    /// `false` when a ray from the eye with unit direction `d` certainly misses the
+    /// sphere in `(0, t_max)`.
+    #[inline(always)]
+    pub(super) fn may_cross(&self, d: Vec3, t_max: f32) -> bool {
+        let bp = -self.f.dot(d);
+        // `&`, not `&&`: one branch on the outcome, not three on its parts.
+        (bp * bp >= self.min_bp2) & (bp + self.reach > 0.0) & (bp - self.reach < t_max)
+    }
+}
+
+/// One sphere as the quick test of shadow rays towards a light sees it
+/// ([`ShadowQuick::may_cross_near`]), kept in each of its entries in the light's grid.
+#[derive(Clone, Copy)]
+pub(super) struct ShadowQuick {
+    /// `light − centre` in `f32`.
+    f: Vec3,
     /// The widened radius grown by the error bound of the line's distance from the
     /// centre worked out without cancellation, as [`super::may_cross`] grows it (here
     /// with `|f|` from `f64`, rounded up).
     wide: f32,
-    /// The slack of `−f·d` itself: the crossings lie within the half chord plus this,
-    /// and within the radius plus this.
+    /// The slack of `−f·d` itself: the crossings lie within the half chord plus this.
     tail: f32,
 }
 
-impl PointQuick {
-    pub(super) fn new(point: DVec3, centre: DVec3, quick: Vec4) -> Self {
-        let f = (point - centre).as_vec3();
-        // `may_cross`'s `|l|² > r² + slack` rewritten as `(f·d)² < |f|² − r² − slack`
-        // (`|l|² = |f|² − (f·d)²`): one dot product a candidate. The rewrite adds
-        // rounding of a few ε·|f|², far below the slack of 2⁻¹⁸·(r² + |f|²), and the
-        // bound is rounded down.
-        let (w, ff) = (f64::from(quick.w), f64::from(f.dot(f)));
-        let slack = f64::from(QUICK_SLACK) * (w * w + ff);
-        let min_bp2 = round_down(ff - w * w - 2.0 * slack);
+impl ShadowQuick {
+    pub(super) fn new(light: DVec3, centre: DVec3, quick: Vec4) -> Self {
         // `f` is rounded from `f64` as in `may_cross`, so the line's distance from the
         // centre as `|f + d·(−f·d)|` errs by at most 13u·|f| there too.
-        let wide = round_up(w + f64::from(LINE_SLACK) * (point - centre).length());
+        let f = (light - centre).as_vec3();
+        let w = f64::from(quick.w);
+        let wide = round_up(w + f64::from(LINE_SLACK) * (light - centre).length());
         let tail = QUICK_SLACK * (f.dot(f).sqrt() + quick.w);
-        PointQuick {
-            f,
-            min_bp2,
-            wide,
-            tail,
-        }
+        ShadowQuick { f, wide, tail }
     }
 
-    /// `false` when a ray from the point with unit direction `d` certainly misses the
-    /// sphere in `(0, t_max)`. (The eye's candidates mostly pass, and its exact test
-    /// is short: the cheaper line test costs less than the looser bound.)
-    #[inline(always)]
-    pub(super) fn may_cross(&self, d: Vec3, t_max: f32) -> bool {
-        let bp = -self.f.dot(d);
-        // The crossings lie within `reach` of `−f·d`.
-        let reach = self.wide + self.tail;
-        // `&`, not `&&`: one branch on the outcome, not three on its parts.
-        (bp * bp >= self.min_bp2) & (bp + reach > 0.0) & (bp - reach < t_max)
-    }
-
-    /// [`PointQuick::may_cross`] for a ray whose line may pass up to `offset` from the
-    /// point (the sphere is widened by `offset`), bounding the crossings by the half
-    /// chord rather than the radius (bounded by the radius, most spheres that pass lie
-    /// just beyond the hit point and are not crossed by the segment), and the line's
-    /// distance from the centre without cancellation: a slack relative to `|f|²`
-    /// passes lines 1.3–1.7 radii from the small balls far from a light, which cost
-    /// a shadow ray's exact test each (85% of them missed at a million balls).
+    /// `false` when a ray from the light with unit direction `d`, whose line may pass
+    /// up to `offset` from the light (the sphere is widened by `offset`), certainly
+    /// misses the sphere in `(0, t_max)`. The crossings are bounded by the half chord
+    /// rather than the radius (bounded by the radius, most spheres that pass lie just
+    /// beyond the hit point and are not crossed by the segment), and the line's
+    /// distance from the centre is worked out without cancellation: a slack relative
+    /// to `|f|²` passes lines 1.3–1.7 radii from the small balls far from a light,
+    /// which cost a shadow ray's exact test each (85% of them missed at a million
+    /// balls).
     #[inline(always)]
     pub(super) fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
         let bp = -self.f.dot(d);
@@ -252,7 +266,7 @@ impl Spheres {
                 .zip(&self.radius)
                 .zip(&self.quick)
                 .map(|((&c, &radius), &quick)| EyeSphere {
-                    quick: PointQuick::new(eye, c, quick),
+                    quick: EyeQuick::new(eye, c, quick),
                     f: eye - c,
                     cterm: power(eye, c, radius),
                     radius,
@@ -453,7 +467,7 @@ impl Spheres {
     }
 
     #[inline(always)]
-    fn shadow_from_start(&self, grid: &DirGrid<PointQuick>, start: &ShadowStart<'_>) -> f32 {
+    fn shadow_from_start(&self, grid: &DirGrid<ShadowQuick>, start: &ShadowStart<'_>) -> f32 {
         let (ray, dist, light) = (&start.ray, start.dist, grid.centre);
         let mut factor = 1.0f32;
         for &k in &grid.always {
@@ -493,7 +507,7 @@ struct ShadowStart<'a> {
 
 impl<'a> ShadowStart<'a> {
     #[inline(always)]
-    fn new(grid: &'a DirGrid<PointQuick>, q: &Query, dist: f64) -> Self {
+    fn new(grid: &'a DirGrid<ShadowQuick>, q: &Query, dist: f64) -> Self {
         ShadowStart {
             ray: Ray::new(q),
             dist,

@@ -9,7 +9,7 @@ use glam::{DVec3, Vec3, Vec4};
 use proptest::prelude::*;
 
 use super::*;
-use crate::accel::point::PointQuick;
+use crate::accel::point::{EyeQuick, ShadowQuick};
 use crate::accel::{may_cross, quick_sphere, sphere_box, Ray};
 
 /// A ray from a point against a sphere, the geometry in `f64`.
@@ -164,9 +164,12 @@ fn the_quick_test_passes_every_ray_that_meets_the_sphere_and_rejects_clear_misse
     );
 }
 
-fn point_quick(c: &Case) -> PointQuick {
-    let centre = c.centre.as_vec3();
-    PointQuick::new(c.point, c.centre, centre.extend(c.radius))
+fn eye_quick(c: &Case) -> EyeQuick {
+    EyeQuick::new(c.point, c.centre, c.centre.as_vec3().extend(c.radius))
+}
+
+fn shadow_quick(c: &Case) -> ShadowQuick {
+    ShadowQuick::new(c.point, c.centre, c.centre.as_vec3().extend(c.radius))
 }
 
 /// The quick test of a ray through a grid's point bounds the crossings by the radius,
@@ -175,8 +178,8 @@ fn point_quick(c: &Case) -> PointQuick {
 #[test]
 fn the_point_s_quick_test_passes_every_ray_that_meets_the_sphere_and_rejects_clear_misses() {
     check(
-        "PointQuick::may_cross",
-        |c| point_quick(c).may_cross(c.d, c.t_max),
+        "EyeQuick::may_cross",
+        |c| eye_quick(c).may_cross(c.d, c.t_max),
         |c| {
             let may = f64::from(c.radius) - c.half_chord(0.0);
             (0.0, Stretch { must: 0.0, may })
@@ -190,8 +193,8 @@ fn the_point_s_quick_test_passes_every_ray_that_meets_the_sphere_and_rejects_cle
 #[test]
 fn the_near_quick_test_passes_every_ray_within_its_offset_and_rejects_clear_misses() {
     check(
-        "PointQuick::may_cross_near",
-        |c| point_quick(c).may_cross_near(c.d, c.t_max, c.offset),
+        "ShadowQuick::may_cross_near",
+        |c| shadow_quick(c).may_cross_near(c.d, c.t_max, c.offset),
         |c| {
             let o = f64::from(c.offset);
             (o, Stretch { must: o, may: o })
@@ -211,7 +214,7 @@ fn the_near_quick_test_rejects_lines_just_outside_a_small_ball_far_away() {
         let towards = DVec3::new(angle.cos(), -1.5, angle.sin()).normalize();
         let across = towards.cross(DVec3::Y).normalize();
         let centre = light + towards * 100.0;
-        let quick = PointQuick::new(light, centre, quick_sphere(centre, r));
+        let quick = ShadowQuick::new(light, centre, quick_sphere(centre, r));
         for (out, passes) in [(1.05, false), (0.95, true)] {
             let d = (towards * 100.0 + across * (out * r)).normalize().as_vec3();
             assert_eq!(
