@@ -187,8 +187,8 @@ impl EyeQuick {
         // (`|l|² = |f|² − (f·d)²`): one dot product a candidate. The rewrite adds
         // rounding of a few ε·|f|², far below the slack of 2⁻¹⁸·(r² + |f|²), and the
         // bound is rounded down. (Looser than `ShadowQuick`'s for small balls far
-        // away, but the eye's candidates mostly pass and its exact test is short: the
-        // tighter test cost hw3 5% more instructions and gained nothing at a million.)
+        // away; but the eye's candidates mostly pass and its exact test is short, so
+        // the one dot product costs less than the tighter test would save.)
         let f = (eye - centre).as_vec3();
         let (w, ff) = (f64::from(quick.w), f64::from(f.dot(f)));
         let slack = f64::from(QUICK_SLACK) * (w * w + ff);
@@ -239,9 +239,8 @@ impl ShadowQuick {
     /// rather than the radius (bounded by the radius, most spheres that pass lie just
     /// beyond the hit point and are not crossed by the segment), and the line's
     /// distance from the centre is worked out without cancellation: a slack relative
-    /// to `|f|²` passes lines 1.3–1.7 radii from the small balls far from a light,
-    /// which cost a shadow ray's exact test each (85% of them missed at a million
-    /// balls).
+    /// to `|f|²` would pass lines well outside a small ball far from the light, each
+    /// a shadow ray's exact test.
     #[inline(always)]
     pub(super) fn may_cross_near(&self, d: Vec3, t_max: f32, offset: f32) -> bool {
         let bp = -self.f.dot(d);
