@@ -226,9 +226,10 @@ impl ShadowQuick {
     pub(super) fn new(light: DVec3, centre: DVec3, quick: Vec4) -> Self {
         // `f` is rounded from `f64` as in `may_cross`, so the line's distance from the
         // centre as `|f + d·(−f·d)|` errs by at most 13u·|f| there too.
-        let f = (light - centre).as_vec3();
+        let rel = light - centre;
+        let f = rel.as_vec3();
         let w = f64::from(quick.w);
-        let wide = round_up(w + f64::from(LINE_SLACK) * (light - centre).length());
+        let wide = round_up(w + f64::from(LINE_SLACK) * rel.length());
         let tail = QUICK_SLACK * (f.dot(f).sqrt() + quick.w);
         ShadowQuick { f, wide, tail }
     }

@@ -294,11 +294,14 @@ pub fn encode(frame: &Frame, format: Format, encoding: Encoding) -> Result<Vec<u
 /// in memory (a plain PPM's text is about four times the pixels' bytes).
 pub fn save_rgb8(image: &RgbImage, path: &Path, format: Format) -> Result<(), SaveError> {
     let mut file = AtomicFile::create(path)?;
-    let mut out = FlushAtEnd(BufWriter::with_capacity(1 << 16, &mut file));
+    let mut out = FlushAtEnd(BufWriter::with_capacity(WRITE_BUFFER, &mut file));
     encode_rgb8(image, format, &mut out).map_err(|e| encode_failure(path, e))?;
     out.finish().map_err(|e| io_failure(path, e))?;
     file.commit()
 }
+
+/// Bytes an encoder's output is gathered in before each write to the file.
+const WRITE_BUFFER: usize = 1 << 16;
 
 /// A buffered writer whose `flush` waits for the end: the PNM encoder flushes after
 /// every line of its text, which would make a system call of every 70 bytes.
@@ -335,7 +338,7 @@ pub fn save(
     }
     let mut file = AtomicFile::create(path)?;
     if let Some(temp) = file.temporary_file() {
-        let mut out = BufWriter::with_capacity(1 << 16, temp);
+        let mut out = BufWriter::with_capacity(WRITE_BUFFER, temp);
         write_exr(frame, None, &mut out).map_err(|e| encode_failure(path, e))?;
         out.flush().map_err(|e| io_failure(path, e))?;
     } else {
@@ -400,7 +403,7 @@ pub(crate) fn write_exr(
     }
     // The frame's rows run from the bottom; the file's from the top.
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
-        let px = frame.pixels[(height - 1 - p.y()) * width + p.x()];
+        let px = frame.get(p.x() as u32, frame.height - 1 - p.y() as u32);
         (px.x, px.y, px.z)
     });
     let mut exr_image = Image::from_layer(Layer::new(
