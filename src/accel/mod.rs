@@ -8,7 +8,7 @@ mod point;
 mod view;
 
 use std::ops::ControlFlow;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use glam::{DVec3, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
@@ -111,6 +111,11 @@ fn grid_resolution(spheres: usize) -> u32 {
 
 /// A directional grid around each light for spheres `(centre, radius)`: the lights
 /// share one grid's bound ([`dirgrid::most_entries_each`]).
+/// Each sphere's centre and radius.
+fn geometry_of(spheres: &[Sphere]) -> Vec<(DVec3, f64)> {
+    spheres.par_iter().map(|s| (s.center, s.radius)).collect()
+}
+
 fn light_grids(spheres: &[(DVec3, f64)], lights: &[DVec3]) -> Vec<PointGrid> {
     let n = grid_resolution(spheres.len());
     let bound = dirgrid::most_entries_each(spheres.len(), lights.len());
@@ -160,8 +165,8 @@ struct LeafSphere {
 
 /// The spheres, for the fast tracer's queries.
 pub(crate) struct Spheres {
-    center: Vec<DVec3>,
-    radius: Vec<f64>,
+    /// Each sphere's centre and radius, shared with the grids' builds.
+    geometry: Arc<Vec<(DVec3, f64)>>,
     /// `1/radius`, for the normals.
     inv_radius: Vec<f64>,
     /// `f32` centre and radius, the radius widened to cover the centre's rounding.
@@ -172,63 +177,91 @@ pub(crate) struct Spheres {
     leaf: Vec<LeafSphere>,
     /// Around each light, for shadow rays.
     lights: Vec<PointGrid>,
-    /// Per sphere, the other spheres that overlap it, if at most [`MOST_OVERLAPS`]:
-    /// all that a ray travelling inside it can meet before its far side (see
-    /// [`Spheres::closest_inside`]). Worked out when a ray first goes inside the
-    /// sphere: most spheres never see one.
-    inside: Vec<OnceLock<Option<Box<[u32]>>>>,
-    /// Spheres of this radius and more keep such a list; rays inside smaller ones walk
-    /// the hierarchy up to the far side instead.
-    list_radius: f64,
+    /// The lists of the spheres that overlap a sphere, for rays inside it.
+    inside: InsideLists,
+}
+
+/// For the spheres that keep one, the other spheres that overlap it, if at most
+/// [`MOST_OVERLAPS`]: all that a ray travelling inside it can meet before its far
+/// side (see [`Spheres::closest_inside`]). Every sphere keeps one in a scene of up
+/// to [`WALK_INSIDE_FROM`] spheres, else those of at least [`list_radius`]; rays
+/// inside the others walk the hierarchy up to the far side instead.
+struct InsideLists {
+    /// The spheres that keep a list, in increasing order; `None` when all do.
+    keepers: Option<Vec<u32>>,
+    /// A keeper's list, at its place in `keepers` (or its index), worked out when a
+    /// ray first goes inside the sphere: most spheres never see one.
+    lists: Vec<OnceLock<Option<Box<[u32]>>>>,
+}
+
+impl InsideLists {
+    fn new(geometry: &[(DVec3, f64)]) -> Self {
+        let fresh = |n: usize| (0..n).into_par_iter().map(|_| OnceLock::new()).collect();
+        if geometry.len() <= WALK_INSIDE_FROM {
+            return InsideLists {
+                keepers: None,
+                lists: fresh(geometry.len()),
+            };
+        }
+        let radius = list_radius(geometry);
+        let keepers: Vec<u32> = (0..geometry.len() as u32)
+            .into_par_iter()
+            .filter(|&k| geometry[k as usize].1 >= radius)
+            .collect();
+        InsideLists {
+            lists: fresh(keepers.len()),
+            keepers: Some(keepers),
+        }
+    }
+
+    /// Sphere `s`'s list, if it keeps one.
+    fn of(&self, s: u32) -> Option<&OnceLock<Option<Box<[u32]>>>> {
+        let place = match &self.keepers {
+            None => s as usize,
+            Some(keepers) => keepers.binary_search(&s).ok()?,
+        };
+        Some(&self.lists[place])
+    }
 }
 
 impl Spheres {
     /// The spheres with a hierarchy for rays of any origin.
     pub(crate) fn new(spheres: &[Sphere]) -> Self {
-        let center: Vec<DVec3> = spheres.par_iter().map(|s| s.center).collect();
-        let radius: Vec<f64> = spheres.par_iter().map(|s| s.radius).collect();
-        let quick: Vec<Vec4> = center
+        Spheres::of_geometry(Arc::new(geometry_of(spheres)))
+    }
+
+    /// [`Spheres::new`] from each sphere's centre and radius.
+    fn of_geometry(geometry: Arc<Vec<(DVec3, f64)>>) -> Self {
+        let quick: Vec<Vec4> = geometry
             .par_iter()
-            .zip(&radius)
-            .map(|(&c, &r)| quick_sphere(c, r))
+            .map(|&(c, r)| quick_sphere(c, r))
             .collect();
-        let bvh = Bvh::build(spheres.len(), |k| sphere_box(center[k], radius[k]));
-        let inside = (0..spheres.len())
-            .into_par_iter()
-            .map(|_| OnceLock::new())
-            .collect();
+        let bvh = Bvh::build(geometry.len(), |k| sphere_box(geometry[k].0, geometry[k].1));
         let leaf = bvh
             .items()
             .par_iter()
-            .map(|&k| LeafSphere {
-                exact: Exact {
-                    center: center[k as usize],
-                    radius: radius[k as usize],
-                    inv_radius: 1.0 / radius[k as usize],
-                },
-                quick_radius: quick[k as usize].w,
-                k,
+            .map(|&k| {
+                let (center, radius) = geometry[k as usize];
+                LeafSphere {
+                    exact: Exact {
+                        center,
+                        radius,
+                        inv_radius: 1.0 / radius,
+                    },
+                    quick_radius: quick[k as usize].w,
+                    k,
+                }
             })
             .collect();
         Spheres {
-            list_radius: list_radius(&radius),
+            inside: InsideLists::new(&geometry),
             bvh,
             leaf,
-            inv_radius: radius.par_iter().map(|r| 1.0 / r).collect(),
-            center,
-            radius,
+            inv_radius: geometry.par_iter().map(|&(_, r)| 1.0 / r).collect(),
+            geometry,
             quick,
             lights: Vec::new(),
-            inside,
         }
-    }
-
-    fn centres_and_radii(&self) -> Vec<(DVec3, f64)> {
-        self.center
-            .iter()
-            .copied()
-            .zip(self.radius.iter().copied())
-            .collect()
     }
 
     /// Adds a directional grid around each light, so that shadow rays test only the
@@ -236,7 +269,7 @@ impl Spheres {
     /// part at a time with it; the tracer builds all at once ([`Spheres::build_for_view`]).
     #[cfg(test)]
     pub(crate) fn with_light_grids(mut self, lights: &[DVec3]) -> Self {
-        self.lights = light_grids(&self.centres_and_radii(), lights);
+        self.lights = light_grids(&self.geometry, lights);
         self
     }
 
@@ -249,14 +282,15 @@ impl Spheres {
         eye: DVec3,
         view: Option<&ViewPyramid>,
     ) -> (Spheres, EyeGrid) {
-        let list: Vec<(DVec3, f64)> = spheres.par_iter().map(|s| (s.center, s.radius)).collect();
+        let geometry = Arc::new(geometry_of(spheres));
+        let list = geometry.as_slice();
         let eye_n = eye_resolution(list.len());
         let (base, (eye_grid, lights)) = rayon::join(
-            || Spheres::new(spheres),
+            || Spheres::of_geometry(Arc::clone(&geometry)),
             || {
                 rayon::join(
-                    || DirGrid::build(eye, &list, eye_n, view),
-                    || light_grids(&list, lights),
+                    || DirGrid::build(eye, list, eye_n, view),
+                    || light_grids(list, lights),
                 )
             },
         );
@@ -268,15 +302,15 @@ impl Spheres {
     /// the only part of the structures that depends on the camera. With `view`, it
     /// answers rays through that pyramid only (a camera's primary rays).
     pub(crate) fn eye_grid(&self, eye: DVec3, view: Option<&ViewPyramid>) -> EyeGrid {
-        let list = self.centres_and_radii();
+        let list = self.geometry.as_slice();
         self.eye_point_grid(
             eye,
-            DirGrid::build(eye, &list, eye_resolution(list.len()), view),
+            DirGrid::build(eye, list, eye_resolution(list.len()), view),
         )
     }
 
     pub(crate) fn len(&self) -> usize {
-        self.center.len()
+        self.geometry.len()
     }
 
     /// `false` when sphere `k` certainly has no crossing in `(0, t_max)` (cheap, `f32`
@@ -284,7 +318,7 @@ impl Spheres {
     /// enough).
     #[inline(always)]
     fn may_cross(&self, k: usize, ray: &Ray, t_max: f32) -> bool {
-        may_cross(self.center[k], self.quick[k].w, ray, t_max)
+        may_cross(self.geometry[k].0, self.quick[k].w, ray, t_max)
     }
 
     /// The first crossing of sphere `k` in `(t_min, t_max)`: `(t, entering, normal)`.
@@ -305,9 +339,10 @@ impl Spheres {
         d: DVec3,
         t_max: f64,
     ) -> Option<(f64, bool, DVec3)> {
+        let (center, radius) = self.geometry[k];
         let sphere = Exact {
-            center: self.center[k],
-            radius: self.radius[k],
+            center,
+            radius,
             inv_radius: self.inv_radius[k],
         };
         crossing_of(k, &sphere, ray, d, t_max)
@@ -338,9 +373,10 @@ impl Spheres {
         // (l ∓ √disc·d)/r is a unit vector up to rounding (|l|² + disc = r², l ⊥ d):
         // no need to normalise again.
         let normal = best.normal;
+        let (center, radius) = self.geometry[best.k];
         Some(Hit {
             sphere: best.k as u32,
-            point: self.center[best.k] + normal * self.radius[best.k],
+            point: center + normal * radius,
             normal,
             entering: best.entering,
         })
@@ -405,9 +441,10 @@ impl Spheres {
         let d64 = unit64(q.dir);
         let mut best = Best::NONE;
         let t_exit = self.consider_exactly(s, &ray, d64, &mut best)?;
-        let list = (self.radius[s as usize] >= self.list_radius)
-            .then(|| self.inside[s as usize].get_or_init(|| self.overlapping(s, MOST_OVERLAPS)))
-            .and_then(Option::as_deref);
+        let list = self.inside.of(s).and_then(|list| {
+            list.get_or_init(|| self.overlapping(s, MOST_OVERLAPS))
+                .as_deref()
+        });
         match list {
             Some(overlaps) => {
                 for &k in overlaps {
@@ -430,12 +467,12 @@ impl Spheres {
     /// are at most `most` of them.
     fn overlapping(&self, s: u32, most: usize) -> Option<Box<[u32]>> {
         let s = s as usize;
-        let (c, r) = (self.center[s], self.radius[s]);
+        let (c, r) = self.geometry[s];
         let bounds = sphere_box(c, r);
         let mut list = Vec::new();
         self.bvh.overlapping(bounds.min, bounds.max, |slot| {
             let k = self.leaf[slot as usize].k as usize;
-            let (ck, rk) = (self.center[k], self.radius[k]);
+            let (ck, rk) = self.geometry[k];
             let reach =
                 (r + rk) * (1.0 + 1e-6) + 1e-9 * (c.abs().max_element() + ck.abs().max_element());
             if k != s && (ck - c).length() <= reach {
@@ -458,7 +495,10 @@ impl Spheres {
     #[inline(always)]
     fn occluder_normal(&self, k: usize, ray: &Ray, dist: f64, light: DVec3) -> Option<DVec3> {
         let (t, entering, n_k) = self.crossing(k, ray, dist)?;
-        let light_power = || power(light, self.center[k], self.radius[k]);
+        let light_power = || {
+            let (c, r) = self.geometry[k];
+            power(light, c, r)
+        };
         crate::model::crosses_before_light(t, dist, entering, light_power).then_some(n_k)
     }
 
@@ -638,11 +678,11 @@ const MOST_OVERLAPS: usize = 16;
 /// sphere in a scene of up to [`WALK_INSIDE_FROM`] spheres, else those more than twice
 /// the median radius (the few large balls, which many of the rays going in enter; the
 /// small glass balls of such a scene are each entered by a ray or two).
-fn list_radius(radius: &[f64]) -> f64 {
-    if radius.len() <= WALK_INSIDE_FROM {
+fn list_radius(geometry: &[(DVec3, f64)]) -> f64 {
+    if geometry.len() <= WALK_INSIDE_FROM {
         return 0.0;
     }
-    let mut sorted = radius.to_vec();
+    let mut sorted: Vec<f64> = geometry.iter().map(|&(_, r)| r).collect();
     let middle = sorted.len() / 2;
     let (_, median, _) = sorted.select_nth_unstable_by(middle, f64::total_cmp);
     2.0 * *median

@@ -261,11 +261,10 @@ impl Spheres {
         let exact = match grid {
             None => Vec::new(),
             Some(_) => self
-                .center
+                .geometry
                 .par_iter()
-                .zip(&self.radius)
                 .zip(&self.quick)
-                .map(|((&c, &radius), &quick)| EyeSphere {
+                .map(|(&(c, radius), &quick)| EyeSphere {
                     quick: EyeQuick::new(eye, c, quick),
                     f: eye - c,
                     cterm: power(eye, c, radius),

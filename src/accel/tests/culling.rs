@@ -11,7 +11,7 @@ use glam::DVec3;
 use proptest::prelude::*;
 
 use super::*;
-use crate::accel::{Hit, Spheres};
+use crate::accel::{Hit, InsideLists, Spheres};
 use crate::scene::Sphere;
 
 /// Random spheres: radius 10^U(−3,3), centre 10^U(−1,4) from the origin.
@@ -493,7 +493,10 @@ fn rays_inside_a_sphere_meet_what_brute_force_meets() {
             // many spheres use for their small ones).
             let with_lists = Spheres::new(&spheres);
             let mut walking = Spheres::new(&spheres);
-            walking.list_radius = f64::INFINITY;
+            walking.inside = InsideLists {
+                keepers: Some(Vec::new()),
+                lists: Vec::new(),
+            };
             // A sphere's list holds the spheres that overlap or touch it, and no
             // other (by a margin of 10⁻⁵ of the two radii).
             for (s, sphere) in spheres.iter().enumerate() {

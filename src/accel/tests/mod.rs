@@ -15,7 +15,7 @@ use glam::DVec3;
 use proptest::strategy::Strategy;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
-use super::{list_radius, round_down, round_up, Query, WALK_INSIDE_FROM};
+use super::{list_radius, round_down, round_up, InsideLists, Query, WALK_INSIDE_FROM};
 use crate::model::Side;
 
 /// A proptest runner of `cases` cases with a fixed seed and no persisted failures.
@@ -189,14 +189,27 @@ fn round_down_is_the_greatest_f32_not_above() {
 /// overlapping spheres; in a larger one, those of more than twice the median radius.
 #[test]
 fn only_large_spheres_of_large_scenes_keep_lists() {
+    let balls =
+        |radii: &[f64]| -> Vec<(DVec3, f64)> { radii.iter().map(|&r| (DVec3::ZERO, r)).collect() };
     let mut radii = vec![0.25; WALK_INSIDE_FROM];
     radii[7] = 1000.0;
-    assert_eq!(list_radius(&radii), 0.0);
+    assert_eq!(list_radius(&balls(&radii)), 0.0);
+    let all = InsideLists::new(&balls(&radii));
+    assert!((0..WALK_INSIDE_FROM as u32).all(|s| all.of(s).is_some()));
     // One more sphere: 2^18 + 1 radii, the median (the 2^17-th from 0) is 0.25.
     radii.push(3.0);
-    assert_eq!(list_radius(&radii), 0.5);
+    assert_eq!(list_radius(&balls(&radii)), 0.5);
+    let few = InsideLists::new(&balls(&radii));
+    let keepers: Vec<u32> = (0..radii.len() as u32)
+        .filter(|&s| few.of(s).is_some())
+        .collect();
+    assert_eq!(keepers, [7, WALK_INSIDE_FROM as u32]);
+    assert_eq!(few.lists.len(), 2, "no list kept for the small balls");
+    // Each keeper its own list.
+    few.of(7).unwrap().set(Some(Box::new([1]))).unwrap();
+    assert!(few.of(WALK_INSIDE_FROM as u32).unwrap().get().is_none());
     // Half the spheres larger: the median moves to the larger radius.
     let n = radii.len();
     radii[..n / 2 + 1].fill(2.0);
-    assert_eq!(list_radius(&radii), 4.0);
+    assert_eq!(list_radius(&balls(&radii)), 4.0);
 }

@@ -5,6 +5,8 @@
 //! shortcuts read. Pixels cannot show any of this (a looser cull gives the same image,
 //! slower), so these tests are what holds it.
 
+use std::sync::OnceLock;
+
 use glam::DVec3;
 use proptest::prop_assert;
 
@@ -65,7 +67,10 @@ fn a_ray_inside_a_ball_tests_only_its_far_side() {
     );
     assert_eq!(tests, 1);
     assert_eq!(
-        set.inside[0].get().map(|list| list.as_deref()),
+        set.inside
+            .of(0)
+            .and_then(OnceLock::get)
+            .map(|list| list.as_deref()),
         Some(Some(&[1][..])),
         "a ball of a small scene keeps its list of overlapping balls"
     );
@@ -94,7 +99,12 @@ fn a_ball_overlapped_by_many_keeps_no_list() {
         );
         let hit = set.closest(&q).expect("ball 1 ahead");
         assert_eq!((hit.sphere, hit.point), (1, DVec3::new(4.5, 0.0, 0.0)));
-        let list = set.inside[0].get().expect("worked out").as_deref();
+        let list = set
+            .inside
+            .of(0)
+            .and_then(OnceLock::get)
+            .expect("worked out")
+            .as_deref();
         assert_eq!(list.map(<[u32]>::len), listed.then_some(ring as usize + 1));
     }
 }
