@@ -129,11 +129,7 @@ impl Bvh {
                 bin: 0,
             })
             .collect();
-        let mut binary = Vec::with_capacity(2 * len.max(1));
-        if len > 0 {
-            let bounds = Bounds::of(&items);
-            build_node(&mut items, bounds, 0, 0, &mut binary);
-        }
+        let binary = binary_tree(&mut items, 0);
         let mut nodes = Vec::with_capacity(binary.len() / 2 + 1);
         if let Some(root) = binary.first() {
             if root.count > 0 {
@@ -428,7 +424,139 @@ fn bin_of(x: f32, lo: f32, scale: f32) -> usize {
     (((x - lo) * scale) as i32).clamp(0, BINS as i32 - 1) as usize
 }
 
-/// Builds the binary subtree over `items`, whose bounds are `bounds`; returns its index.
+/// The binary tree over `items` (reordered into leaf order), its root at `depth`,
+/// flattened depth-first: a node's left child follows it.
+fn binary_tree(items: &mut [BuildItem], depth: u32) -> Vec<Node> {
+    if items.is_empty() {
+        return Vec::new();
+    }
+    let bounds = Bounds::of(items);
+    let tree = subtree(items, bounds, 0, depth);
+    let mut nodes = Vec::with_capacity(tree.len());
+    tree.splice_into(&mut nodes);
+    nodes
+}
+
+/// A binary subtree as it is built: on one thread, its nodes depth-first (indices
+/// relative to its first); or, over many items, its root and both halves, each built
+/// on a thread of its own. Spliced into one vector once the whole tree is built,
+/// every node is copied once (spliced at every split, the nodes below a split were
+/// copied again at each split above it).
+enum Subtree {
+    Nodes(Vec<Node>),
+    Split(Node, Box<[Subtree; 2]>),
+}
+
+impl Subtree {
+    fn len(&self) -> usize {
+        match self {
+            Subtree::Nodes(nodes) => nodes.len(),
+            Subtree::Split(_, halves) => 1 + halves[0].len() + halves[1].len(),
+        }
+    }
+
+    /// Appends the subtree to `out` depth-first, with the right children's indices
+    /// made absolute.
+    fn splice_into(self, out: &mut Vec<Node>) {
+        match self {
+            Subtree::Nodes(nodes) => {
+                let base = out.len() as u32;
+                out.extend(nodes.into_iter().map(|mut n| {
+                    if n.count == 0 {
+                        n.index += base; // inner: the right child's index
+                    }
+                    n
+                }));
+            }
+            Subtree::Split(root, halves) => {
+                let me = out.len();
+                out.push(root);
+                let [left, right] = *halves;
+                left.splice_into(out);
+                out[me].index = out.len() as u32;
+                right.splice_into(out);
+            }
+        }
+    }
+}
+
+/// The subtree over `items`, whose bounds are `bounds`: over many items, split and
+/// built on two threads.
+fn subtree(items: &mut [BuildItem], bounds: Bounds, first: u32, depth: u32) -> Subtree {
+    if !items_len_is_large(items.len()) {
+        // At most 2n − 1 nodes over n items; the room not used is never touched.
+        let mut nodes = Vec::with_capacity(2 * items.len());
+        build_node(items, bounds, first, depth, &mut nodes);
+        return Subtree::Nodes(nodes);
+    }
+    let split = divide(items, &bounds, depth).expect("more items than a leaf holds split");
+    let (left_items, right_items) = items.split_at_mut(split.mid);
+    let halves = rayon::join(
+        || subtree(left_items, split.left, first, depth + 1),
+        || {
+            subtree(
+                right_items,
+                split.right,
+                first + split.mid as u32,
+                depth + 1,
+            )
+        },
+    );
+    let root = Node {
+        bounds: bounds.boxes,
+        index: 0, // the right child's, once spliced
+        count: 0,
+        axis: split.axis as u32,
+    };
+    Subtree::Split(root, Box::new(halves.into()))
+}
+
+/// How a node's items divide: `items[..mid]` go left, with bounds `left`.
+struct Division {
+    axis: usize,
+    mid: usize,
+    left: Bounds,
+    right: Bounds,
+}
+
+/// Splits `items` (bounds `bounds`, at `depth`) in place; `None` for a leaf.
+fn divide(items: &mut [BuildItem], bounds: &Bounds, depth: u32) -> Option<Division> {
+    if items.len() <= MAX_LEAF {
+        return None;
+    }
+    let sah = if depth < MAX_SAH_DEPTH {
+        best_split(items, bounds)
+    } else {
+        None
+    };
+    // Otherwise a split by count: deep in the tree, so that the depth stays within the
+    // stack, and for a set too large for a leaf (spheres with one centre); else a leaf.
+    let by_count = depth >= MAX_SAH_DEPTH || items.len() > LARGEST_LEAF;
+    match sah {
+        Some(split) => Some(Division {
+            axis: split.axis,
+            mid: partition(items, |item| split.goes_left(item)),
+            left: split.left,
+            right: split.right,
+        }),
+        None if by_count => {
+            let axis = (bounds.centres.max - bounds.centres.min).max_position();
+            items.sort_unstable_by(|a, b| a.centre_on(axis).total_cmp(&b.centre_on(axis)));
+            let mid = items.len() / 2;
+            let (l, r) = items.split_at(mid);
+            Some(Division {
+                axis,
+                mid,
+                left: Bounds::of(l),
+                right: Bounds::of(r),
+            })
+        }
+        None => None, // no split beats a leaf
+    }
+}
+
+/// Builds the binary subtree over `items`, whose bounds are `bounds`, into `nodes`
+/// on this thread; returns its index there.
 fn build_node(
     items: &mut [BuildItem],
     bounds: Bounds,
@@ -443,65 +571,26 @@ fn build_node(
         count: items.len() as u32,
         axis: 0,
     });
-    if items.len() <= MAX_LEAF {
+    let Some(split) = divide(items, &bounds, depth) else {
         return me;
-    }
-    let sah = if depth < MAX_SAH_DEPTH {
-        best_split(items, &bounds)
-    } else {
-        None
     };
-    // Otherwise a split by count: deep in the tree, so that the depth stays within the
-    // stack, and for a set too large for a leaf (spheres with one centre); else a leaf.
-    let by_count = depth >= MAX_SAH_DEPTH || items.len() > LARGEST_LEAF;
-    let (axis, mid, left, right) = match sah {
-        Some(split) => {
-            let mid = partition(items, |item| split.goes_left(item));
-            (split.axis, mid, split.left, split.right)
-        }
-        None if by_count => {
-            let axis = (bounds.centres.max - bounds.centres.min).max_position();
-            items.sort_unstable_by(|a, b| a.centre_on(axis).total_cmp(&b.centre_on(axis)));
-            let mid = items.len() / 2;
-            let (l, r) = items.split_at(mid);
-            (axis, mid, Bounds::of(l), Bounds::of(r))
-        }
-        None => return me, // no split beats a leaf
-    };
-    let (left_items, right_items) = items.split_at_mut(mid);
-    let right_index = if items_len_is_large(left_items.len() + right_items.len()) {
-        // Big subtrees build on two threads, into their own vectors, then splice.
-        let (mut l, mut r) = (Vec::new(), Vec::new());
-        rayon::join(
-            || build_node(left_items, left, first, depth + 1, &mut l),
-            || build_node(right_items, right, first + mid as u32, depth + 1, &mut r),
-        );
-        let base = nodes.len() as u32;
-        nodes.extend(l.into_iter().map(|n| offset(n, base)));
-        let right_base = nodes.len() as u32;
-        nodes.extend(r.into_iter().map(|n| offset(n, right_base)));
-        right_base
-    } else {
-        build_node(left_items, left, first, depth + 1, nodes);
-        build_node(right_items, right, first + mid as u32, depth + 1, nodes)
-    };
-    nodes[me as usize].index = right_index;
-    nodes[me as usize].count = 0;
-    nodes[me as usize].axis = axis as u32;
+    let (left_items, right_items) = items.split_at_mut(split.mid);
+    build_node(left_items, split.left, first, depth + 1, nodes);
+    let right = build_node(
+        right_items,
+        split.right,
+        first + split.mid as u32,
+        depth + 1,
+        nodes,
+    );
+    let node = &mut nodes[me as usize];
+    (node.index, node.count, node.axis) = (right, 0, split.axis as u32);
     me
 }
 
 /// Subtrees this big are worth a thread of their own.
 fn items_len_is_large(n: usize) -> bool {
     n >= 8192
-}
-
-/// A node of a subtree built at index 0, moved to start at `base`.
-fn offset(mut n: Node, base: u32) -> Node {
-    if n.count == 0 {
-        n.index += base; // inner: right-child index is relative to the subtree
-    }
-    n
 }
 
 /// The binned-SAH split, or `None` when a leaf is cheaper (or the centres coincide).
@@ -1278,9 +1367,7 @@ mod tests {
             .map(|k| item(boxes[k as usize], k))
             .collect();
         let start = MAX_SAH_DEPTH - 3;
-        let mut nodes = Vec::new();
-        let bounds = Bounds::of(&items);
-        build_node(&mut items, bounds, 0, start, &mut nodes);
+        let nodes = binary_tree(&mut items, start);
         // The slots under binary node `b`.
         fn slots(nodes: &[Node], b: usize) -> std::ops::Range<usize> {
             let n = &nodes[b];
