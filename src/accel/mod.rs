@@ -285,12 +285,15 @@ impl Spheres {
         let geometry = Arc::new(geometry_of(spheres));
         let list = geometry.as_slice();
         let eye_n = eye_resolution(list.len());
-        let (base, (eye_grid, lights)) = rayon::join(
+        // The lights' grids before the eye's: the build then ends on the eye grid,
+        // whose work on one thread alone (its counting sort) is the shorter, and the
+        // thread done with the hierarchy meanwhile shares its parallel parts.
+        let (base, (lights, eye_grid)) = rayon::join(
             || Spheres::of_geometry(Arc::clone(&geometry)),
             || {
                 rayon::join(
-                    || DirGrid::build(eye, list, eye_n, view),
                     || light_grids(list, lights),
+                    || DirGrid::build(eye, list, eye_n, view),
                 )
             },
         );
