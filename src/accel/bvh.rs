@@ -439,9 +439,8 @@ fn binary_tree(items: &mut [BuildItem], depth: u32) -> Vec<Node> {
 
 /// A binary subtree as it is built: on one thread, its nodes depth-first (indices
 /// relative to its first); or, over many items, its root and both halves, each built
-/// on a thread of its own. Spliced into one vector once the whole tree is built,
-/// every node is copied once (spliced at every split, the nodes below a split were
-/// copied again at each split above it).
+/// on a thread of its own. Spliced into one vector once the whole tree is built, so
+/// that every node is copied once, whatever the number of splits above it.
 enum Subtree {
     Nodes(Vec<Node>),
     Split(Node, Box<[Subtree; 2]>),

@@ -109,13 +109,13 @@ fn grid_resolution(spheres: usize) -> u32 {
     }
 }
 
-/// A directional grid around each light for spheres `(centre, radius)`: the lights
-/// share one grid's bound ([`dirgrid::most_entries_each`]).
 /// Each sphere's centre and radius.
 fn geometry_of(spheres: &[Sphere]) -> Vec<(DVec3, f64)> {
     spheres.par_iter().map(|s| (s.center, s.radius)).collect()
 }
 
+/// A directional grid around each light for spheres `(centre, radius)`: the lights
+/// share one grid's bound ([`dirgrid::most_entries_each`]).
 fn light_grids(spheres: &[(DVec3, f64)], lights: &[DVec3]) -> Vec<PointGrid> {
     let n = grid_resolution(spheres.len());
     let bound = dirgrid::most_entries_each(spheres.len(), lights.len());
