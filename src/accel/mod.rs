@@ -225,7 +225,9 @@ impl InsideLists {
 }
 
 impl Spheres {
-    /// The spheres with a hierarchy for rays of any origin.
+    /// The spheres with a hierarchy for rays of any origin (the tracer builds them
+    /// with its grids, [`Spheres::build_for_view`]).
+    #[cfg(any(test, all(feature = "cli", feature = "viewer")))]
     pub(crate) fn new(spheres: &[Sphere]) -> Self {
         Spheres::of_geometry(Arc::new(geometry_of(spheres)))
     }
