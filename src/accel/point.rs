@@ -190,10 +190,10 @@ impl EyeQuick {
         // away; but the eye's candidates mostly pass and its exact test is short, so
         // the one dot product costs less than the tighter test would save.)
         let f = (eye - centre).as_vec3();
-        let (w, ff) = (f64::from(quick.w), f64::from(f.dot(f)));
-        let slack = f64::from(QUICK_SLACK) * (w * w + ff);
-        let min_bp2 = round_down(ff - w * w - 2.0 * slack);
         let ff = f.dot(f);
+        let w = f64::from(quick.w);
+        let slack = f64::from(QUICK_SLACK) * (w * w + f64::from(ff));
+        let min_bp2 = round_down(f64::from(ff) - w * w - 2.0 * slack);
         let reach = quick.w + QUICK_SLACK * (ff.sqrt() + quick.w);
         EyeQuick { f, min_bp2, reach }
     }
