@@ -398,6 +398,14 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
     /// The cell of direction `d` (any length, not zero).
     #[inline]
     pub(super) fn cell(&self, d: Vec3) -> usize {
+        let (face, u, v) = self.place(d);
+        cell_index(face, u, v, self.n)
+    }
+
+    /// The face of direction `d` (any length, not zero) and its cell's column and row
+    /// on that face.
+    #[inline]
+    fn place(&self, d: Vec3) -> (u32, u32, u32) {
         let a = d.abs();
         let (face, major, u, v) = if a.x >= a.y && a.x >= a.z {
             (u32::from(d.x < 0.0), a.x, d.y, d.z)
@@ -410,7 +418,30 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         let half_n = self.half_n;
         let scale = half_n / major;
         let to_cell = |x: f32| ((x * scale + half_n) as u32).min(self.n - 1);
-        cell_index(face, to_cell(u), to_cell(v), self.n)
+        (face, to_cell(u), to_cell(v))
+    }
+
+    /// Whether the cells of one face that directions `a` and `b` fall in, and every
+    /// cell of that face between them (the rectangle of columns and rows they span),
+    /// list no sphere. The directions between `a` and `b` (the segment between them)
+    /// project into that rectangle: a face's pyramid is convex, and central projection
+    /// takes a segment to a segment.
+    #[inline]
+    pub(super) fn lists_nothing_between(&self, a: Vec3, b: Vec3) -> bool {
+        let ((face, ua, va), (face_b, ub, vb)) = (self.place(a), self.place(b));
+        if face != face_b {
+            return false;
+        }
+        let (u0, u1) = (ua.min(ub), ua.max(ub));
+        // A row of a face's cells is contiguous in the offsets: its columns `u0..=u1`
+        // are empty when their first start equals their last end.
+        (va.min(vb)..=va.max(vb)).all(|v| {
+            let (first, last) = (
+                cell_index(face, u0, v, self.n),
+                cell_index(face, u1, v, self.n),
+            );
+            self.offsets[first] == self.offsets[last + 1]
+        })
     }
 
     /// The spheres of a cell with their nearest distances, nearest first.

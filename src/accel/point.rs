@@ -370,12 +370,20 @@ impl Spheres {
     /// fall in one cell (a cell is a square in its face's plane, and the row's
     /// directions between project to the segment between, inside it; cells list every
     /// sphere seen within a widened cone, which covers the rounding of the directions
-    /// many times over) and the eye is inside no sphere.
+    /// many times over) and the eye is inside no sphere. When they fall in different
+    /// cells of one face and no cell between lists a sphere, a run that sees nothing.
     #[inline(never)]
     pub(crate) fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
         let grid = eye.shortcut(self.len())?;
         let cell = grid.cell(a);
-        (cell == grid.cell(b)).then(|| EyeRun::of_cell(grid, cell))
+        if cell == grid.cell(b) {
+            return Some(EyeRun::of_cell(grid, cell));
+        }
+        // Across cells, the run is sky if none of them lists a sphere: in a large
+        // scene a cell is narrower than a run, and the sky above the balls is many
+        // runs.
+        grid.lists_nothing_between(a, b)
+            .then_some(EyeRun { candidates: &[] })
     }
 
     #[inline(always)]

@@ -352,11 +352,13 @@ fn a_camera_s_eye_grid_keeps_every_sphere_its_film_sees() {
 
 /// The tracer's sky runs: when `eye_sees_nothing_between` says a row of directions sees
 /// only sky, every direction between (as a row of pixels computes them) misses every
-/// sphere, by brute force in `f64`, and the eye query agrees.
+/// sphere, by brute force in `f64`, and the eye query agrees. Rows from a thousandth of
+/// a radian (within a cell) to 0.4 (across several cells, and faces).
 #[test]
 fn sky_runs_see_no_sphere() {
-    let counts = RefCell::new((0u64, 0u64)); // (runs said empty, directions checked)
-    let runs = prop::collection::vec((unit_vector(), unit_vector(), 0.0f64..0.008), 32);
+    // (runs said empty, of them across cells, directions checked)
+    let counts = RefCell::new((0u64, 0u64, 0u64));
+    let runs = prop::collection::vec((unit_vector(), unit_vector(), log_uniform(-3.0, -0.4)), 32);
     runner(200)
         .run(
             &(world(), log_uniform(-1.0, 4.0), unit_vector(), runs),
@@ -376,9 +378,13 @@ fn sky_runs_see_no_sphere() {
                         continue;
                     }
                     c.0 += 1;
+                    let cells = grid
+                        .shortcut(spheres.len())
+                        .map(|g| g.cell(dir(0.0)) != g.cell(dir(1.0)));
+                    c.1 += u64::from(cells == Some(true));
                     for step in 0..=16 {
                         let d = dir(step as f32 / 16.0);
-                        c.1 += 1;
+                        c.2 += 1;
                         let q = Query {
                             origin: eye,
                             dir: d,
@@ -397,9 +403,12 @@ fn sky_runs_see_no_sphere() {
             },
         )
         .unwrap_or_else(|e| panic!("{e}\n{:?}", counts.borrow()));
-    let (empty, checked) = counts.into_inner();
-    println!("sky runs: {empty} said empty, {checked} directions checked");
-    assert!(empty > 500, "too few empty runs to say anything: {empty}");
+    let (empty, across, checked) = counts.into_inner();
+    println!("sky runs: {empty} said empty ({across} across cells), {checked} directions checked");
+    assert!(
+        empty > 500 && across > 200,
+        "too few empty runs to say anything: {empty}, {across} across cells"
+    );
 }
 
 /// The tracer's shared cells: when `eye_run` says a row of directions lies in one cell
