@@ -6,7 +6,7 @@
 use std::ops::ControlFlow;
 
 use arrayvec::ArrayVec;
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
 use wide::{f32x4, CmpGe, CmpLe};
 
@@ -40,25 +40,61 @@ impl Aabb {
 }
 
 /// An item as the build moves it: its box, its index, and its bin in the split being
-/// made (in what would otherwise be padding).
+/// made, in 32 bytes: the index and the bin ride in the fourth lanes of the box's
+/// corners, as `f32` values (exact below 2^24; a subnormal bit pattern there would make
+/// the lanes' arithmetic slow). Every level of the build reads every item once or
+/// twice, so an item's size is the memory a level moves.
 #[derive(Clone, Copy)]
 struct BuildItem {
-    bounds: Aabb,
-    index: u32,
-    bin: u32,
+    /// The box's least corner; lane w, the index.
+    min: Vec4,
+    /// The box's greatest corner; lane w, the bin.
+    max: Vec4,
 }
 
+const _: () = assert!(std::mem::size_of::<BuildItem>() == 32);
+
 impl BuildItem {
+    fn new(bounds: Aabb, index: u32) -> BuildItem {
+        BuildItem {
+            min: bounds.min.extend(index as f32),
+            max: bounds.max.extend(0.0),
+        }
+    }
+
+    #[inline]
+    fn bounds(&self) -> Aabb {
+        Aabb {
+            min: Vec3A::from_vec4(self.min),
+            max: Vec3A::from_vec4(self.max),
+        }
+    }
+
+    #[inline]
+    fn index(&self) -> u32 {
+        self.min.w as u32
+    }
+
+    #[inline]
+    fn bin(&self) -> f32 {
+        self.max.w
+    }
+
+    #[inline]
+    fn set_bin(&mut self, bin: usize) {
+        self.max.w = bin as f32;
+    }
+
     #[inline]
     fn centre(&self) -> Vec3A {
-        self.bounds.centre()
+        self.bounds().centre()
     }
 
     /// The centre's coordinate on `axis`: the same number as `centre()[axis]`, read
     /// from memory (a lane picked at run time from a register goes through the stack).
     #[inline]
     fn centre_on(&self, axis: usize) -> f32 {
-        (self.bounds.min[axis] + self.bounds.max[axis]) * 0.5
+        (self.min[axis] + self.max[axis]) * 0.5
     }
 }
 
@@ -119,15 +155,13 @@ impl Bvh {
     /// Builds over `len` items, item `k` in the box `bounds(k)`: a binary binned-SAH
     /// tree, then collapsed.
     pub(super) fn build(len: usize, bounds: impl Fn(usize) -> Aabb + Sync) -> Bvh {
+        // An item's `f32` lane holds its index exactly (scenes hold at most 2^20).
+        assert!(len <= 1 << 24, "at most 2^24 items");
         // Each item's box travels with it as the splits reorder the items, so every
         // level of the build reads them in order.
         let mut items: Vec<BuildItem> = (0..len)
             .into_par_iter()
-            .map(|k| BuildItem {
-                bounds: bounds(k),
-                index: k as u32,
-                bin: 0,
-            })
+            .map(|k| BuildItem::new(bounds(k), k as u32))
             .collect();
         let binary = binary_tree(&mut items, 0);
         let mut nodes = Vec::with_capacity(binary.len() / 2 + 1);
@@ -139,7 +173,7 @@ impl Bvh {
                 collapse(&binary, 0, &mut nodes);
             }
         }
-        let items = items.iter().map(|item| item.index).collect();
+        let items = items.iter().map(BuildItem::index).collect();
         Bvh { nodes, items }
     }
 
@@ -388,7 +422,7 @@ impl Bounds {
 
     #[inline]
     fn add(&mut self, item: &BuildItem) {
-        self.boxes.grow(&item.bounds);
+        self.boxes.grow(&item.bounds());
         let c = item.centre();
         self.centres.min = self.centres.min.min(c);
         self.centres.max = self.centres.max.max(c);
@@ -405,7 +439,8 @@ impl Bounds {
 /// the bins, so no child measures its items again.
 struct Split {
     axis: usize,
-    last_left: u32,
+    /// A bin number, as the items hold it.
+    last_left: f32,
     left: Bounds,
     right: Bounds,
 }
@@ -413,7 +448,7 @@ struct Split {
 impl Split {
     #[inline]
     fn goes_left(&self, item: &BuildItem) -> bool {
-        item.bin <= self.last_left
+        item.bin() <= self.last_left
     }
 }
 
@@ -610,7 +645,7 @@ fn best_split(items: &mut [BuildItem], bounds: &Bounds) -> Option<Split> {
         let b = bin_of(item.centre_on(axis), lo, scale);
         bins[b].add(item);
         bin_count[b] += 1;
-        item.bin = b as u32;
+        item.set_bin(b);
     }
     // Sweep from the right, keeping each plane's right-hand cost and count, then from
     // the left, evaluating the cost of each plane.
@@ -645,7 +680,7 @@ fn best_split(items: &mut [BuildItem], bounds: &Bounds) -> Option<Split> {
     let leaf_cost = bounds.boxes.half_area() * items.len() as f32;
     (cost < leaf_cost || items.len() > LARGEST_LEAF).then_some(Split {
         axis,
-        last_left: last_left as u32,
+        last_left: last_left as f32,
         left,
         right,
     })
@@ -728,11 +763,7 @@ mod tests {
     }
 
     fn item(bounds: Aabb, index: u32) -> BuildItem {
-        BuildItem {
-            bounds,
-            index,
-            bin: 0,
-        }
+        BuildItem::new(bounds, index)
     }
 
     /// Each leaf of the tree: the union of its items' boxes (from `boxes`, not the
@@ -756,6 +787,26 @@ mod tests {
     /// Half the surface area (the SAH's measure of how often a ray meets a box), by
     /// hand: 1·2 + 2·3 + 3·1 for a 1×2×3 box; a flat box has its one face; an empty or
     /// point box none.
+    /// An item gives back its box, its index (up to 2^24 − 1) and its bin exactly.
+    #[test]
+    fn items_keep_their_box_index_and_bin() {
+        let bounds = Aabb {
+            min: Vec3A::new(-1.5, 2.0e-30, 7.0),
+            max: Vec3A::new(3.25, 1.0e30, 7.5),
+        };
+        for index in [0, 1, 12_345, (1 << 20) + 1, (1 << 24) - 1] {
+            let mut it = item(bounds, index);
+            assert_eq!(it.index(), index);
+            assert_eq!(it.bin(), 0.0);
+            it.set_bin(BINS - 1);
+            assert_eq!((it.index(), it.bin()), (index, (BINS - 1) as f32));
+            let b = it.bounds();
+            assert_eq!((b.min, b.max), (bounds.min, bounds.max));
+            assert_eq!(it.centre(), Vec3A::new(0.875, 5.0e29, 7.25));
+            assert_eq!(it.centre_on(2), 7.25);
+        }
+    }
+
     #[test]
     fn half_area_is_half_the_surface_area() {
         let b = |min: [f32; 3], max: [f32; 3]| Aabb {
@@ -817,12 +868,14 @@ mod tests {
                         .collect();
                     let mut items: Vec<BuildItem> =
                         (0..len).map(|k| item(unit, k as u32)).collect();
-                    let mid = partition(&mut items, |it| goes_left[it.index as usize]);
+                    let mid = partition(&mut items, |it| goes_left[it.index() as usize]);
                     let want = goes_left.iter().filter(|&&b| b).count();
                     assert_eq!(mid, want, "len {len}, share {share}, runs {runs}");
-                    assert!(items[..mid].iter().all(|it| goes_left[it.index as usize]));
-                    assert!(items[mid..].iter().all(|it| !goes_left[it.index as usize]));
-                    let mut seen: Vec<u32> = items.iter().map(|it| it.index).collect();
+                    assert!(items[..mid].iter().all(|it| goes_left[it.index() as usize]));
+                    assert!(items[mid..]
+                        .iter()
+                        .all(|it| !goes_left[it.index() as usize]));
+                    let mut seen: Vec<u32> = items.iter().map(|it| it.index()).collect();
                     seen.sort_unstable();
                     assert!(seen.iter().copied().eq(0..len as u32), "len {len}");
                     checked += 1;
@@ -859,7 +912,7 @@ mod tests {
             let mut places: Vec<u32> = Vec::new();
             for it in items.iter().filter(|it| split.goes_left(it) == side) {
                 b.add(it);
-                places.push(it.index);
+                places.push(it.index());
             }
             places.sort_unstable();
             (
@@ -1385,9 +1438,12 @@ mod tests {
             let all = slots(&nodes, b);
             let right = nodes[b].index as usize;
             let left_slots = slots(&nodes, b + 1);
-            let mut left: Vec<u32> = items[left_slots.clone()].iter().map(|i| i.index).collect();
+            let mut left: Vec<u32> = items[left_slots.clone()]
+                .iter()
+                .map(|i| i.index())
+                .collect();
             left.sort_unstable();
-            let node_items: Vec<u32> = items[all.clone()].iter().map(|i| i.index).collect();
+            let node_items: Vec<u32> = items[all.clone()].iter().map(|i| i.index()).collect();
             if depth < MAX_SAH_DEPTH {
                 let mut copy: Vec<BuildItem> = node_items
                     .iter()
@@ -1398,7 +1454,7 @@ mod tests {
                 let mut expected: Vec<u32> = copy
                     .iter()
                     .filter(|i| split.goes_left(i))
-                    .map(|i| i.index)
+                    .map(|i| i.index())
                     .collect();
                 expected.sort_unstable();
                 assert_eq!(left, expected, "the SAH's split at depth {depth}");
@@ -1416,7 +1472,7 @@ mod tests {
                     .fold(f32::MIN, f32::max);
                 let right_min = items[left_slots.end..all.end]
                     .iter()
-                    .map(|i| centre(i.index)[axis])
+                    .map(|i| centre(i.index())[axis])
                     .fold(f32::MAX, f32::min);
                 assert!(
                     left_max <= right_min,
