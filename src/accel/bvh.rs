@@ -784,9 +784,6 @@ mod tests {
             .collect()
     }
 
-    /// Half the surface area (the SAH's measure of how often a ray meets a box), by
-    /// hand: 1·2 + 2·3 + 3·1 for a 1×2×3 box; a flat box has its one face; an empty or
-    /// point box none.
     /// An item gives back its box, its index (up to 2^24 − 1) and its bin exactly.
     #[test]
     fn items_keep_their_box_index_and_bin() {
@@ -807,6 +804,9 @@ mod tests {
         }
     }
 
+    /// Half the surface area (the SAH's measure of how often a ray meets a box), by
+    /// hand: 1·2 + 2·3 + 3·1 for a 1×2×3 box; a flat box has its one face; an empty or
+    /// point box none.
     #[test]
     fn half_area_is_half_the_surface_area() {
         let b = |min: [f32; 3], max: [f32; 3]| Aabb {

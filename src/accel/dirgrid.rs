@@ -398,14 +398,19 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
     /// The cell of direction `d` (any length, not zero).
     #[inline]
     pub(super) fn cell(&self, d: Vec3) -> usize {
-        let (face, u, v) = self.place(d);
-        cell_index(face, u, v, self.n)
+        self.cell_at(self.place(d))
     }
 
-    /// The face of direction `d` (any length, not zero) and its cell's column and row
-    /// on that face.
+    /// The cell at `place`.
     #[inline]
-    fn place(&self, d: Vec3) -> (u32, u32, u32) {
+    pub(super) fn cell_at(&self, place: CellPlace) -> usize {
+        cell_index(place.face, place.u, place.v, self.n)
+    }
+
+    /// Where direction `d` (any length, not zero) falls: its face, and its cell's
+    /// column and row on that face.
+    #[inline]
+    pub(super) fn place(&self, d: Vec3) -> CellPlace {
         let a = d.abs();
         let (face, major, u, v) = if a.x >= a.y && a.x >= a.z {
             (u32::from(d.x < 0.0), a.x, d.y, d.z)
@@ -418,27 +423,30 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         let half_n = self.half_n;
         let scale = half_n / major;
         let to_cell = |x: f32| ((x * scale + half_n) as u32).min(self.n - 1);
-        (face, to_cell(u), to_cell(v))
+        CellPlace {
+            face,
+            u: to_cell(u),
+            v: to_cell(v),
+        }
     }
 
-    /// Whether the cells of one face that directions `a` and `b` fall in, and every
-    /// cell of that face between them (the rectangle of columns and rows they span),
-    /// list no sphere. The directions between `a` and `b` (the segment between them)
+    /// Whether the cells at `a` and `b`, on one face, and every cell of that face
+    /// between them (the rectangle of columns and rows they span) list no sphere. The
+    /// directions between two that fall at `a` and `b` (the segment between them)
     /// project into that rectangle: a face's pyramid is convex, and central projection
     /// takes a segment to a segment.
     #[inline]
-    pub(super) fn lists_nothing_between(&self, a: Vec3, b: Vec3) -> bool {
-        let ((face, ua, va), (face_b, ub, vb)) = (self.place(a), self.place(b));
-        if face != face_b {
+    pub(super) fn lists_nothing_between(&self, a: CellPlace, b: CellPlace) -> bool {
+        if a.face != b.face {
             return false;
         }
-        let (u0, u1) = (ua.min(ub), ua.max(ub));
+        let (u0, u1) = (a.u.min(b.u), a.u.max(b.u));
         // A row of a face's cells is contiguous in the offsets: its columns `u0..=u1`
         // are empty when their first start equals their last end.
-        (va.min(vb)..=va.max(vb)).all(|v| {
+        (a.v.min(b.v)..=a.v.max(b.v)).all(|v| {
             let (first, last) = (
-                cell_index(face, u0, v, self.n),
-                cell_index(face, u1, v, self.n),
+                cell_index(a.face, u0, v, self.n),
+                cell_index(a.face, u1, v, self.n),
             );
             self.offsets[first] == self.offsets[last + 1]
         })
@@ -450,6 +458,15 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         let (start, end) = (self.offsets[cell] as usize, self.offsets[cell + 1] as usize);
         &self.items[start..end]
     }
+}
+
+/// Where a direction falls in a grid ([`DirGrid::place`]): its face, and its cell's
+/// column `u` and row `v` on that face.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) struct CellPlace {
+    face: u32,
+    u: u32,
+    v: u32,
 }
 
 /// The cone of directions of each cell of a face (the same for all six faces in face

@@ -375,14 +375,14 @@ impl Spheres {
     #[inline(never)]
     pub(crate) fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
         let grid = eye.shortcut(self.len())?;
-        let cell = grid.cell(a);
-        if cell == grid.cell(b) {
-            return Some(EyeRun::of_cell(grid, cell));
+        let (at_a, at_b) = (grid.place(a), grid.place(b));
+        if at_a == at_b {
+            return Some(EyeRun::of_cell(grid, grid.cell_at(at_a)));
         }
         // Across cells, the run is sky if none of them lists a sphere: in a large
         // scene a cell is narrower than a run, and the sky above the balls is many
         // runs.
-        grid.lists_nothing_between(a, b)
+        grid.lists_nothing_between(at_a, at_b)
             .then_some(EyeRun { candidates: &[] })
     }
 
