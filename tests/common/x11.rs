@@ -81,7 +81,9 @@ impl XServer {
             let display = format!(":{number}");
             let child = Command::new("Xvfb")
                 // No reset when the last client leaves: a server resetting refuses
-                // connections for a moment, and the probe below is such a client.
+                // connections for a moment, and the probe below is such a client. No
+                // autorepeat: on a loaded machine `xdotool key` can be descheduled
+                // between press and release for longer than the repeat delay.
                 .args([
                     &display,
                     "-screen",
@@ -90,6 +92,7 @@ impl XServer {
                     "-nolisten",
                     "tcp",
                     "-noreset",
+                    "-r",
                 ])
                 .stdout(Stdio::null())
                 .stderr(Stdio::from(log.reopen().unwrap()))
