@@ -37,7 +37,7 @@ impl PointGrid {
         let quick = |c: DVec3, r: f64| ShadowQuick::new(point, c, quick_sphere(c, r));
         PointGrid {
             centre: point,
-            grid: DirGrid::build_with(point, spheres, n, None, quick, bound),
+            grid: DirGrid::build_with(point, spheres, n, None, quick, bound, true),
         }
     }
 
@@ -51,6 +51,12 @@ impl PointGrid {
     #[cfg(test)]
     pub(crate) fn has_grid(&self) -> bool {
         self.grid.is_some()
+    }
+
+    /// The spheres the grid lists apart from its cells (see [`DirGrid::build_with`]).
+    #[cfg(test)]
+    pub(crate) fn wide(&self) -> usize {
+        self.grid.as_ref().map_or(0, |g| g.wide.len())
     }
 
     /// The grid's cells a face side and the room it takes in the unit of its bound
@@ -480,17 +486,20 @@ impl Spheres {
         for &k in &grid.always {
             self.occlude(k, ray, dist, light, &mut factor);
         }
-        for &Listed { k, near, data } in start.candidates {
-            if f64::from(near) >= dist || factor <= 0.0 {
-                break; // beyond the hit point, seen from the light
-            }
-            if ray.from == Some((k, Side::Outward))
-                || !data.may_cross_near(start.back, start.dist32, start.offset)
-            {
-                continue;
-            }
-            if let Some(n_k) = self.occluder_normal(k as usize, ray, dist, light) {
-                factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
+        // The factor is the least of the occluders', whatever their order.
+        for list in [&grid.wide[..], start.candidates] {
+            for &Listed { k, near, data } in list {
+                if f64::from(near) >= dist || factor <= 0.0 {
+                    break; // beyond the hit point, seen from the light
+                }
+                if ray.from == Some((k, Side::Outward))
+                    || !data.may_cross_near(start.back, start.dist32, start.offset)
+                {
+                    continue;
+                }
+                if let Some(n_k) = self.occluder_normal(k as usize, ray, dist, light) {
+                    factor = factor.min(crate::model::occluder_factor(ray.d32, n_k.as_vec3()));
+                }
             }
         }
         factor

@@ -119,6 +119,10 @@ struct Counts {
     shadowed: u64,
     shadow_ambiguous: u64,
     shadow_wrong: u64,
+    /// Worlds whose light's grid lists spheres apart, seen wide, and the shadow rays
+    /// tested in them.
+    wide_worlds: u64,
+    wide_shadow_rays: u64,
 }
 
 #[test]
@@ -140,6 +144,8 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                 let set = Spheres::new(&spheres).with_light_grids(&[light]);
                 let eye_grid = set.eye_grid(eye, None);
                 let mut c = counts.borrow_mut();
+                let wide = set.lights[0].wide() > 0;
+                c.wide_worlds += u64::from(wide);
                 for &(u, pick, spread) in &rays {
                     // Aimed within 1.3 radii of a random sphere's centre: hits, misses
                     // and silhouettes alike.
@@ -199,6 +205,7 @@ fn culling_never_loses_a_hit_or_an_occluder() {
                     c.hits += 1;
                     let (sq, dist, want) = shadow_case(&spheres, &hit, light);
                     c.shadow_rays += 1;
+                    c.wide_shadow_rays += u64::from(wide);
                     let Some(want) = want else {
                         c.shadow_ambiguous += 1;
                         continue;
@@ -223,11 +230,13 @@ fn culling_never_loses_a_hit_or_an_occluder() {
         .unwrap_or_else(|e| panic!("{e}\n{:?}", counts.borrow()));
     let c = counts.into_inner();
     println!(
-        "culling: {} primary rays ({} ambiguous, left out; {} hits), {} wrong; {} shadow rays ({} ambiguous, {} shadowed), {} wrong",
-        c.rays, c.ambiguous, c.hits, c.wrong, c.shadow_rays, c.shadow_ambiguous, c.shadowed, c.shadow_wrong
+        "culling: {} primary rays ({} ambiguous, left out; {} hits), {} wrong; {} shadow rays ({} ambiguous, {} shadowed), {} wrong; {} worlds with wide spheres apart, {} shadow rays in them",
+        c.rays, c.ambiguous, c.hits, c.wrong, c.shadow_rays, c.shadow_ambiguous, c.shadowed, c.shadow_wrong, c.wide_worlds, c.wide_shadow_rays
     );
     assert!(
-        c.rays - c.ambiguous > 5000 && c.shadow_rays - c.shadow_ambiguous > 1000,
+        c.rays - c.ambiguous > 5000
+            && c.shadow_rays - c.shadow_ambiguous > 1000
+            && c.wide_shadow_rays > 200,
         "{c:?}"
     );
 }
