@@ -10,7 +10,7 @@ mod view;
 use std::ops::ControlFlow;
 use std::sync::{Arc, OnceLock};
 
-use glam::{DVec3, Vec3, Vec3A, Vec4};
+use glam::{DVec3, Vec3, Vec3A};
 use rayon::prelude::*;
 
 use bvh::{Aabb, Bvh};
@@ -125,11 +125,11 @@ fn light_grids(spheres: &[(DVec3, f64)], lights: &[DVec3]) -> Vec<PointGrid> {
         .collect()
 }
 
-/// The `f32` centre and radius of the quick test, the radius widened to cover the
-/// centre's rounding.
-fn quick_sphere(c: DVec3, r: f64) -> Vec4 {
+/// The radius of the quick tests in `f32`, widened to cover the rounding of the
+/// centre (or its offset from a ray's origin) to `f32`.
+fn quick_radius(c: DVec3, r: f64) -> f32 {
     let widen = 4.0 * f64::from(f32::EPSILON) * (c.abs().max_element() + r);
-    c.as_vec3().extend((r + widen) as f32)
+    (r + widen) as f32
 }
 
 /// The `f32` box of a sphere in the hierarchy: widened by a little more than `f32`'s
@@ -169,8 +169,8 @@ pub(crate) struct Spheres {
     geometry: Arc<Vec<(DVec3, f64)>>,
     /// `1/radius`, for the normals.
     inv_radius: Vec<f64>,
-    /// `f32` centre and radius, the radius widened to cover the centre's rounding.
-    quick: Vec<Vec4>,
+    /// The quick tests' radius ([`quick_radius`]).
+    quick_radius: Vec<f32>,
     bvh: Bvh,
     /// What the hierarchy's queries read of each sphere, in its leaf order: a leaf's
     /// spheres sit side by side in memory instead of scattered over the scene's order.
@@ -234,9 +234,9 @@ impl Spheres {
 
     /// [`Spheres::new`] from each sphere's centre and radius.
     fn of_geometry(geometry: Arc<Vec<(DVec3, f64)>>) -> Self {
-        let quick: Vec<Vec4> = geometry
+        let quick_radius: Vec<f32> = geometry
             .par_iter()
-            .map(|&(c, r)| quick_sphere(c, r))
+            .map(|&(c, r)| quick_radius(c, r))
             .collect();
         let bvh = Bvh::build(geometry.len(), |k| sphere_box(geometry[k].0, geometry[k].1));
         let leaf = bvh
@@ -250,7 +250,7 @@ impl Spheres {
                         radius,
                         inv_radius: 1.0 / radius,
                     },
-                    quick_radius: quick[k as usize].w,
+                    quick_radius: quick_radius[k as usize],
                     k,
                 }
             })
@@ -261,7 +261,7 @@ impl Spheres {
             leaf,
             inv_radius: geometry.par_iter().map(|&(_, r)| 1.0 / r).collect(),
             geometry,
-            quick,
+            quick_radius,
             lights: Vec::new(),
         }
     }
@@ -323,7 +323,7 @@ impl Spheres {
     /// enough).
     #[inline(always)]
     fn may_cross(&self, k: usize, ray: &Ray, t_max: f32) -> bool {
-        may_cross(self.geometry[k].0, self.quick[k].w, ray, t_max)
+        may_cross(self.geometry[k].0, self.quick_radius[k], ray, t_max)
     }
 
     /// The first crossing of sphere `k` in `(t_min, t_max)`: `(t, entering, normal)`.

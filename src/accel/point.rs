@@ -3,12 +3,12 @@
 //! each sphere worked out once per point: only the direction varies between them.
 //! The answers are those of the general queries of [`Spheres`], to the bit.
 
-use glam::{DVec3, Vec3, Vec4};
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::dirgrid::{DirGrid, Listed};
 use super::{
-    quick_sphere, round_down, round_up, unit64, Best, Hit, Query, Ray, Spheres, LINE_SLACK,
+    quick_radius, round_down, round_up, unit64, Best, Hit, Query, Ray, Spheres, LINE_SLACK,
     QUICK_SLACK, U32,
 };
 use crate::intersect::{power, roots_from};
@@ -34,7 +34,7 @@ impl PointGrid {
     /// ([`DirGrid::build_with`]), each entry with its sphere's [`ShadowQuick`] from
     /// `point`.
     pub(super) fn build(point: DVec3, spheres: &[(DVec3, f64)], n: u32, bound: usize) -> PointGrid {
-        let quick = |c: DVec3, r: f64| ShadowQuick::new(point, c, quick_sphere(c, r));
+        let quick = |c: DVec3, r: f64| ShadowQuick::new(point, c, quick_radius(c, r));
         PointGrid {
             centre: point,
             grid: DirGrid::build_with(point, spheres, n, None, quick, bound, true),
@@ -188,7 +188,7 @@ pub(super) struct EyeQuick {
 }
 
 impl EyeQuick {
-    pub(super) fn new(eye: DVec3, centre: DVec3, quick: Vec4) -> Self {
+    pub(super) fn new(eye: DVec3, centre: DVec3, quick_radius: f32) -> Self {
         // `may_cross`'s `|l|² > r² + slack` rewritten as `(f·d)² < |f|² − r² − slack`
         // (`|l|² = |f|² − (f·d)²`): one dot product a candidate. The rewrite adds
         // rounding of a few ε·|f|², far below the slack of 2⁻¹⁸·(r² + |f|²), and the
@@ -197,10 +197,10 @@ impl EyeQuick {
         // the one dot product costs less than the tighter test would save.)
         let f = (eye - centre).as_vec3();
         let ff = f.dot(f);
-        let w = f64::from(quick.w);
+        let w = f64::from(quick_radius);
         let slack = f64::from(QUICK_SLACK) * (w * w + f64::from(ff));
         let min_bp2 = round_down(f64::from(ff) - w * w - 2.0 * slack);
-        let reach = quick.w + QUICK_SLACK * (ff.sqrt() + quick.w);
+        let reach = quick_radius + QUICK_SLACK * (ff.sqrt() + quick_radius);
         EyeQuick { f, min_bp2, reach }
     }
 
@@ -229,14 +229,14 @@ pub(super) struct ShadowQuick {
 }
 
 impl ShadowQuick {
-    pub(super) fn new(light: DVec3, centre: DVec3, quick: Vec4) -> Self {
+    pub(super) fn new(light: DVec3, centre: DVec3, quick_radius: f32) -> Self {
         // `f` is rounded from `f64` as in `may_cross`, so the line's distance from the
         // centre as `|f + d·(−f·d)|` errs by at most 13u·|f| there too.
         let rel = light - centre;
         let f = rel.as_vec3();
-        let w = f64::from(quick.w);
+        let w = f64::from(quick_radius);
         let wide = round_up(w + f64::from(LINE_SLACK) * rel.length());
-        let tail = QUICK_SLACK * (f.dot(f).sqrt() + quick.w);
+        let tail = QUICK_SLACK * (f.dot(f).sqrt() + quick_radius);
         ShadowQuick { f, wide, tail }
     }
 
@@ -269,9 +269,9 @@ impl Spheres {
             Some(_) => self
                 .geometry
                 .par_iter()
-                .zip(&self.quick)
-                .map(|(&(c, radius), &quick)| EyeSphere {
-                    quick: EyeQuick::new(eye, c, quick),
+                .zip(&self.quick_radius)
+                .map(|(&(c, radius), &quick_radius)| EyeSphere {
+                    quick: EyeQuick::new(eye, c, quick_radius),
                     f: eye - c,
                     cterm: power(eye, c, radius),
                     radius,
