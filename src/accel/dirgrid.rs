@@ -1212,8 +1212,11 @@ mod tests {
             grid.items.len() + in_cells(&together, 0) + in_cells(&together, 1),
             together.items.len()
         );
-        let fewest = |apart| fewest_entries(centre, &spheres, n, None, apart);
-        assert!(fewest(true) < fewest(false) && fewest(true) <= grid.items.len() as f64);
+        // Apart, the two wide spheres count none and the others as they would alone.
+        let fewest = fewest_entries(centre, &spheres, n, None, true);
+        let alone = fewest_entries(centre, &spheres[2..], n, None, false);
+        assert!((fewest - alone).abs() <= 1e-9 * alone, "{fewest} {alone}");
+        assert!(fewest >= 21.0 && fewest <= grid.items.len() as f64);
         // Wide spheres, one more than are kept apart: all in the cells.
         let mut crowd = spheres.clone();
         for k in 0..MOST_WIDE - 1 {
