@@ -57,6 +57,13 @@ const SPHERES_PER_RUN: usize = 2048;
 /// or above it, pass its cells and test it all the same.
 const WIDE_SIN: f64 = 0.5;
 
+/// Whether a sphere of radius `r`, its centre `dist` from the grid's point, is seen
+/// wide ([`WIDE_SIN`]).
+#[inline]
+fn seen_wide(r: f64, dist: f64) -> bool {
+    r >= WIDE_SIN * dist
+}
+
 /// The most spheres a grid keeps apart; with more (a crowd close around the point,
 /// which every ray would then test) all stay in the cells.
 const MOST_WIDE: usize = 8;
@@ -131,7 +138,7 @@ fn fewest_entries(
         .filter(|&&(c, r)| view.is_none_or(|view| view.may_see(c - centre, r)))
         .map(|&(c, r)| {
             let dist = (c - centre).length();
-            if dist <= r || (wide_apart && r >= WIDE_SIN * dist) {
+            if dist <= r || (wide_apart && seen_wide(r, dist)) {
                 return 0.0;
             }
             // ω = 2π(1 − cos θ), sin θ = r/dist; rounding errs far below the 1%.
@@ -191,7 +198,7 @@ fn cells_of(
         out.always.push(k);
         return;
     }
-    if wide_apart && r >= WIDE_SIN * dist {
+    if wide_apart && seen_wide(r, dist) {
         out.wide.push(place);
         return;
     }
