@@ -215,7 +215,8 @@ impl EyeQuick {
 }
 
 /// One sphere as the quick test of shadow rays towards a light sees it
-/// ([`ShadowQuick::may_cross_near`]), kept in each of its entries in the light's grid.
+/// ([`ShadowQuick::may_cross_near`]), kept in each of its entries in the light's grid
+/// (24 bytes an entry with its index and distance).
 #[derive(Clone, Copy)]
 pub(super) struct ShadowQuick {
     /// `light − centre` in `f32`.
@@ -224,8 +225,6 @@ pub(super) struct ShadowQuick {
     /// centre worked out without cancellation, as [`super::may_cross`] grows it (here
     /// with `|f|` from `f64`, rounded up).
     wide: f32,
-    /// The slack of `−f·d` itself: the crossings lie within the half chord plus this.
-    tail: f32,
 }
 
 impl ShadowQuick {
@@ -236,8 +235,17 @@ impl ShadowQuick {
         let f = rel.as_vec3();
         let w = f64::from(quick_radius);
         let wide = round_up(w + f64::from(LINE_SLACK) * rel.length());
-        let tail = QUICK_SLACK * (f.dot(f).sqrt() + quick_radius);
-        ShadowQuick { f, wide, tail }
+        ShadowQuick { f, wide }
+    }
+
+    /// The slack of `−f·d` itself: the crossings lie within the half chord plus this.
+    /// `may_cross`'s `QUICK_SLACK·(|f| + r)` with `|f|` bounded by `1.75·|f|∞` (at
+    /// most √3 times it) and `r` by the widened radius: derived from the entry rather
+    /// than kept in it, which makes a light's entries a seventh smaller. A larger tail
+    /// only lets more candidates through to the exact test.
+    #[inline(always)]
+    pub(super) fn tail(&self) -> f32 {
+        QUICK_SLACK * (1.75 * self.f.abs().max_element() + self.wide)
     }
 
     /// `false` when a ray from the light with unit direction `d`, whose line may pass
@@ -255,7 +263,7 @@ impl ShadowQuick {
         let wide = self.wide + offset;
         let chord2 = wide * wide * (1.0 + 8.0 * U32) - l.dot(l);
         // NaN when the line misses (chord2 < 0): it fails every comparison.
-        let reach = chord2.sqrt() + self.tail + offset;
+        let reach = chord2.sqrt() + self.tail() + offset;
         (chord2 >= 0.0) & (bp + reach > 0.0) & (bp - reach < t_max)
     }
 }

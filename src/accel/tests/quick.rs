@@ -10,7 +10,7 @@ use proptest::prelude::*;
 
 use super::*;
 use crate::accel::point::{EyeQuick, ShadowQuick};
-use crate::accel::{may_cross, quick_radius, sphere_box, Ray};
+use crate::accel::{may_cross, quick_radius, sphere_box, Ray, QUICK_SLACK};
 
 /// A ray from a point against a sphere, the geometry in `f64`.
 #[derive(Debug)]
@@ -224,6 +224,31 @@ fn the_near_quick_test_rejects_lines_just_outside_a_small_ball_far_away() {
             );
         }
     }
+}
+
+/// The shadow entries' tail, derived from `|f|∞`, is at least the slack `may_cross`
+/// gives `−f·d` (`QUICK_SLACK·(|f| + r)`, in `f64`) and at most twice it: along the
+/// diagonals `|f|` is √3·`|f|∞`, the most it can be.
+#[test]
+fn the_shadow_entries_tail_covers_the_slack_of_the_distance_along_the_line() {
+    let diagonal = Just(DVec3::ONE.normalize()).boxed();
+    let directions = prop_oneof![unit_vector().boxed(), diagonal];
+    runner(4000)
+        .run(
+            &(sphere(), directions, log_uniform(-2.0, 5.0)),
+            |((c, r), u, d)| {
+                let light = c + u * d;
+                let w = quick_radius(c, r);
+                let tail = f64::from(ShadowQuick::new(light, c, w).tail());
+                let slack = f64::from(QUICK_SLACK) * ((light - c).length() + f64::from(w));
+                assert!(
+                    tail >= slack && tail <= 2.0 * slack,
+                    "{c} {r} {light}: {tail} against {slack}"
+                );
+                Ok(())
+            },
+        )
+        .unwrap();
 }
 
 /// A sphere of radius 10^U(−3, 5) with its centre 10^U(−2, 5) from the origin.
