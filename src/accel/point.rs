@@ -239,10 +239,10 @@ impl ShadowQuick {
     }
 
     /// The slack of `−f·d` itself: the crossings lie within the half chord plus this.
-    /// `may_cross`'s `QUICK_SLACK·(|f| + r)` with `|f|` bounded by `1.75·|f|∞` (at
-    /// most √3 times it) and `r` by the widened radius: derived from the entry rather
-    /// than kept in it, which makes a light's entries a seventh smaller. A larger tail
-    /// only lets more candidates through to the exact test.
+    /// `may_cross`'s `QUICK_SLACK·(|f| + r)`, with `|f|` bounded by `1.75·|f|∞` (`|f|`
+    /// is at most √3·`|f|∞`) and `r` by the widened radius: derived from the entry, not
+    /// kept in it, for a smaller entry. A larger tail only lets more candidates through
+    /// to the exact test.
     #[inline(always)]
     pub(super) fn tail(&self) -> f32 {
         QUICK_SLACK * (1.75 * self.f.abs().max_element() + self.wide)
