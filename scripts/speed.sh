@@ -13,8 +13,13 @@
 # render and build (median s, `whitted time`), Embree's build (median s), and the
 # peak resident memory of `whitted render` (MB, the largest of the runs).
 #
+# Then the viewer's line: a whole frame of hw3 at 1280×720 on two threads while the
+# camera orbits (`whitted time --orbit $ORBIT --no-preview`, the median frame) against
+# the Embree peer's hw3 render on two threads (median of RUNS), and their ratio.
+#
 # Environment: OUT (run.sh's output folder, default /tmp/peers-out), MANY (default
-# "1000 10000 100000 1000000"), RUNS (default 5), THREADS (default "1 2"), WHITTED
+# "1000 10000 100000 1000000"), RUNS (default 5), THREADS (default "1 2"), ORBIT
+# (views of the viewer's orbit, default 40; 0 leaves the viewer's line out), WHITTED
 # (the binary to time, default target/release/whitted, built first), EMBREE (the peer
 # binary, default the newest under $OUT/bin).
 set -euo pipefail
@@ -72,3 +77,13 @@ for scene in hw3 $(for n in $MANY; do echo "many_$n"; done); do
             "$(median <"$tmp/ebuild")" "$(sort -g "$tmp/mem" | tail -1)"
     done
 done
+ORBIT=${ORBIT:-40}
+if [ "$ORBIT" -gt 0 ]; then
+    frame=$("$WHITTED" time --orbit "$ORBIT" --no-preview --threads 2 | field frame_ms)
+    : >"$tmp/erender"
+    for _ in $(seq "$RUNS"); do
+        NO_BENCH=1 "$EMBREE" "$SCN/hw3.txt" "$tmp/e.ppm" 2 | grep '^RESULT' | field render_s >>"$tmp/erender"
+    done
+    e=$(median <"$tmp/erender")
+    echo "viewer: hw3 orbit ($ORBIT views, 2 threads) $frame ms a frame; Embree's hw3 render $e s; ÷ $(awk -v f="$frame" -v e="$e" 'BEGIN { printf "%.2f", f / 1000 / e }')"
+fi
