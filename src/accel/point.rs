@@ -29,6 +29,9 @@ pub(crate) struct PointGrid {
 /// constants.
 type Candidate = Listed<ShadowQuick>;
 
+// A light's entry: 24 bytes, as `ShadowQuick`'s comment says (its tail is derived).
+const _: () = assert!(size_of::<Candidate>() == 24);
+
 impl PointGrid {
     /// The grid around `point` for spheres `(centre, radius)` within `bound`
     /// ([`DirGrid::build_with`]), each entry with its sphere's [`ShadowQuick`] from
