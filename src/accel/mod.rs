@@ -238,23 +238,22 @@ impl Spheres {
             .par_iter()
             .map(|&(c, r)| quick_radius(c, r))
             .collect();
-        let bvh = Bvh::build(geometry.len(), |k| sphere_box(geometry[k].0, geometry[k].1));
-        let leaf = bvh
-            .items()
-            .par_iter()
-            .map(|&k| {
-                let (center, radius) = geometry[k as usize];
+        let (bvh, leaf) = Bvh::build(
+            geometry.len(),
+            |k| {
+                let (center, radius) = geometry[k];
                 LeafSphere {
                     exact: Exact {
                         center,
                         radius,
                         inv_radius: 1.0 / radius,
                     },
-                    quick_radius: quick_radius[k as usize],
-                    k,
+                    quick_radius: quick_radius[k],
+                    k: k as u32,
                 }
-            })
-            .collect();
+            },
+            |leaf| sphere_box(leaf.exact.center, leaf.exact.radius),
+        );
         Spheres {
             inside: InsideLists::new(&geometry),
             bvh,

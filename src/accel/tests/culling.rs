@@ -679,6 +679,44 @@ fn large_scenes_lose_no_hit_or_occluder() {
     assert!(shadows > 1500 && shadowed > 100, "{shadows} {shadowed}");
 }
 
+/// Above 2^18 spheres the hierarchy comes from the Morton order: in the peers' scene
+/// of 300,000 balls on the ground, the sphere a ray from a point among the balls
+/// meets through the hierarchy equals brute force in `f64` (ambiguous cases left
+/// out).
+#[test]
+fn a_hierarchy_from_the_morton_order_loses_no_hit() {
+    let scene = crate::scene::many_scene(300_000);
+    let spheres = &scene.spheres;
+    let set = Spheres::new(spheres);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut walks, mut on_balls) = (0u32, 0u32);
+    for _ in 0..400 {
+        let s = &spheres[((next() * spheres.len() as f64) as usize).min(spheres.len() - 1)];
+        let u = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+        let aim = s.center + u * (2.6 * s.radius);
+        let from = DVec3::new(next() - 0.5, 0.1 * next(), next() - 0.5) * 100.0;
+        let q = Query {
+            origin: from,
+            dir: (aim - from).normalize().as_vec3().normalize(),
+            from: None,
+        };
+        let Some(want) = nearest_sphere(&q, spheres) else {
+            continue;
+        };
+        walks += 1;
+        on_balls += u32::from(want.is_some_and(|k| k >= 4));
+        assert_eq!(set.closest(&q).map(|h| h.sphere), want, "walk {q:?}");
+    }
+    println!("{walks} walks ({on_balls} on small balls)");
+    assert!(walks > 350 && on_balls > 200, "{walks} {on_balls}");
+}
+
 /// The lights' grids share one grid's bound: over 20,000 small balls one light gets
 /// its grid at the finest resolution, each of 64 lights a coarser one, and 1,024
 /// lights none (their shadow rays walk the hierarchy); every shadow factor, from
