@@ -600,6 +600,23 @@ fn nearest_sphere(q: &Query, spheres: &[Sphere]) -> Option<Option<u32>> {
     (!(all.iter().any(|x| x.3) || tie)).then(|| sorted.first().map(|x| x.0 as u32))
 }
 
+/// Uniform numbers in [0, 1) from a xorshift generator seeded with `state`.
+fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A point within 1.3 radii of a sphere's centre, the sphere drawn at random.
+fn aim_near_a_ball(next: &mut impl FnMut() -> f64, spheres: &[Sphere]) -> DVec3 {
+    let s = &spheres[((next() * spheres.len() as f64) as usize).min(spheres.len() - 1)];
+    let u = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+    s.center + u * (2.6 * s.radius)
+}
+
 /// Fine grids (the eye's 128 cells a face for 4,097 to 65,536 spheres, the lights'
 /// finest, 256) and a hierarchy whose big subtrees are built on threads of their own: the
 /// peers' scene of 20,000 balls on the ground, seen from its camera. Every primary
@@ -615,20 +632,12 @@ fn large_scenes_lose_no_hit_or_occluder() {
     let set = Spheres::new(spheres).with_light_grids(&[light]);
     let eye_grid = set.eye_grid(eye, None);
     // A fixed sequence of rays, each aimed within 1.3 radii of a sphere's centre.
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
     let (mut tested, mut ambiguous, mut shadows) = (0u32, 0u32, 0u32);
     let (mut balls, mut shadowed) = (0u32, 0u32);
     let (mut walks, mut walks_on_balls) = (0u32, 0u32);
     for _ in 0..3000 {
-        let s = &spheres[((next() * spheres.len() as f64) as usize).min(spheres.len() - 1)];
-        let u = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
-        let aim = s.center + u * (2.6 * s.radius);
+        let aim = aim_near_a_ball(&mut next, spheres);
         let q = Query {
             origin: eye,
             dir: (aim - eye).normalize().as_vec3().normalize(),
@@ -688,18 +697,10 @@ fn a_hierarchy_from_the_morton_order_loses_no_hit() {
     let scene = crate::scene::many_scene(300_000);
     let spheres = &scene.spheres;
     let set = Spheres::new(spheres);
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = xorshift(0x2545_f491_4f6c_dd1d);
     let (mut walks, mut on_balls) = (0u32, 0u32);
     for _ in 0..400 {
-        let s = &spheres[((next() * spheres.len() as f64) as usize).min(spheres.len() - 1)];
-        let u = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
-        let aim = s.center + u * (2.6 * s.radius);
+        let aim = aim_near_a_ball(&mut next, spheres);
         let from = DVec3::new(next() - 0.5, 0.1 * next(), next() - 0.5) * 100.0;
         let q = Query {
             origin: from,
