@@ -28,8 +28,8 @@ fi
 files=()
 if ! printf '%s\n' "$@" | grep -qx -- '-f\|--file'; then
     for f in src/model.rs src/camera.rs src/sampling.rs src/intersect.rs 'src/trace/*.rs' \
-        'src/accel/*.rs' src/render/film.rs src/render/resolve.rs src/render/adaptive.rs \
-        src/image_io/srgb.rs src/image_io/mod.rs; do
+        'src/accel/*.rs' 'src/accel/bvh/*.rs' src/render/film.rs src/render/resolve.rs \
+        src/render/adaptive.rs src/image_io/srgb.rs src/image_io/mod.rs; do
         files+=(--file "$f")
     done
 fi
