@@ -143,18 +143,19 @@ const _: () = assert!(std::mem::size_of::<WideNode>() == 32 * WIDTH);
 /// Items above which the tree is built from their Morton order ([`morton`]). At a
 /// million spheres the binned-SAH tree and its records take 0.26–0.30 s of one
 /// thread, the build's longest part, the Morton tree and its records 0.13–0.15 s, for
-/// a walk about 5% longer. Below, the build is a smaller part of a render and the
+/// a walk 4–8% longer. Below, the build is a smaller part of a render and the
 /// walk a larger one, and the Morton tree does worse where spheres cluster (1.29× the
 /// binned tree's expected work over 60 clusters of different sizes, 1.06× over the
 /// peers' even spread).
-const MORTON_ABOVE: usize = 1 << 18;
+pub(super) const MORTON_ABOVE: usize = 1 << 18;
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
 /// No leaf holds more items than this (a leaf's count is a byte): larger sets split by
 /// count even where no split beats a leaf (spheres with one centre).
 const LARGEST_LEAF: usize = 16;
-/// Depth after which splits are by count: keeps any tree below `STACK` levels.
+/// Depth after which splits are by count: keeps any tree below `STACK` levels (a
+/// Morton tree's paths have at most 31 splits at a code bit and log2(n) halvings).
 const MAX_SAH_DEPTH: u32 = 48;
 /// `WIDTH − 1` waiting entries a level (siblings of every node on the path) for a path
 /// of up to 100 levels, and then some.
@@ -170,6 +171,9 @@ impl Bvh {
         record: impl Fn(usize) -> R + Sync,
         bounds: impl Fn(&R) -> Aabb + Sync,
     ) -> (Bvh, Vec<R>) {
+        // An index fits a `u32`, and the binned build's `f32` lane (scenes hold at most
+        // 2^20 spheres).
+        assert!(len <= 1 << 24, "at most 2^24 items");
         if len > MORTON_ABOVE {
             morton::build(len, record, bounds)
         } else {
@@ -183,8 +187,6 @@ impl Bvh {
         record: impl Fn(usize) -> R + Sync,
         bounds: impl Fn(&R) -> Aabb + Sync,
     ) -> (Bvh, Vec<R>) {
-        // An item's `f32` lane holds its index exactly (scenes hold at most 2^20).
-        assert!(len <= 1 << 24, "at most 2^24 items");
         // Each item's box travels with it as the splits reorder the items, so every
         // level of the build reads them in order.
         let mut items: Vec<BuildItem> = (0..len)
@@ -1330,8 +1332,8 @@ mod tests {
             visited.push(place(k));
             Some(boxes[k].min.x - o.x)
         });
-        // Exactly the leaf of the first box: the next leaf's box is entered at t = 19
-        // at the nearest, beyond the hit at 10.
+        // Exactly the leaf of the first box: the next leaf's box is entered at t ≥ 13,
+        // beyond the hit at 10.
         let first_slot = items.iter().position(|&k| place(k as usize) == 0.0);
         let leaf: Vec<f32> = bvh
             .nodes
@@ -1636,11 +1638,13 @@ mod tests {
             }
         };
         let within = |b: &Aabb| {
-            let inside = Aabb {
-                min: b.min.max(region.min),
-                max: b.max.min(region.max),
-            };
-            f64::from(inside.half_area())
+            let (min, max) = (b.min.max(region.min), b.max.min(region.max));
+            let inside = Aabb { min, max };
+            if min.cmple(max).all() {
+                f64::from(inside.half_area())
+            } else {
+                0.0
+            }
         };
         let mut work = 0.0;
         for n in &bvh.nodes {
@@ -1657,10 +1661,9 @@ mod tests {
 
     /// The Morton order's tree over the many_N scenes' shape (20,000 small boxes in a
     /// layer 10 × 0.1 × 10 on a ground box 2,000 wide whose centre lies 1,000 below
-    /// them) does about the binned SAH's work for rays through the layer (1.06× is
-    /// measured). With the ground's centre in the codes' grid, the small boxes shared
-    /// a few hundred codes and split in the scene's order: 7.9×; with the grid's
-    /// steps stretched to the layer's thickness, thin slices of the layer: 3.8×.
+    /// them) does about the binned SAH's work for rays through the layer: the ground
+    /// stays out of the small boxes' grid, and the grid's steps are cubes, not slices
+    /// of the layer's thickness (1.06× is measured; without either, 7.9× and 3.8×).
     #[test]
     fn the_morton_tree_keeps_a_huge_box_apart() {
         let mut unit = uniform_f32(5);

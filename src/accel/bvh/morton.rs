@@ -1,6 +1,6 @@
 //! The hierarchy of a large scene, built from its items' Morton order (a linear BVH,
-//! Lauterbach et al. 2009): the centres quantized on a grid of 2^10 steps an axis,
-//! their coordinates' bits interleaved into one code, the items sorted by it (a radix
+//! Lauterbach et al. 2009): the centres quantized on a cubic grid, 2^10 steps over
+//! their largest extent, their coordinates' bits interleaved into one code, the items sorted by it (a radix
 //! sort), and every node's items split where their codes' highest differing bit
 //! changes. Each split is a binary search in the sorted codes, where the binned
 //! surface-area heuristic reads every item of every level twice.
@@ -54,7 +54,7 @@ pub(super) fn build<R: Send>(
     // leaves' boxes are then read from them in order.
     let records: Vec<R> = keyed.par_iter().map(|&(_, k)| record(k as usize)).collect();
     let codes: Vec<u32> = keyed.into_iter().map(|(code, _)| code).collect();
-    let tree = Morton {
+    let tree = SortedItems {
         codes: &codes,
         records: &records,
         bounds: &bounds,
@@ -83,7 +83,7 @@ impl Grid {
 
     fn over(centres: &Aabb) -> Grid {
         let extent = (centres.max - centres.min).max_element();
-        // One step on all three axes: a grid stretched to the centres' extent on each
+        // One step length for all three axes: a grid stretched to the centres' extent on each
         // would split a thin layer of balls into thinner ones early, each box as wide
         // as the layer (3.8 times the work of the binned SAH's tree for a ray through
         // a random layer 100 wide and 1 thick, against 1.06 with cubes).
@@ -139,15 +139,15 @@ pub(super) fn spread(x: u32) -> u32 {
     x
 }
 
-/// The sorted items and their codes, as the nodes are made from them.
-struct Morton<'a, R, B> {
+/// The items sorted by their codes, as the nodes are made from them.
+struct SortedItems<'a, R, B> {
     codes: &'a [u32],
     /// The items' records, in the codes' order.
     records: &'a [R],
     bounds: &'a B,
 }
 
-impl<R, B: Fn(&R) -> Aabb> Morton<'_, R, B> {
+impl<R, B: Fn(&R) -> Aabb> SortedItems<'_, R, B> {
     /// Splits the slots `range` (more than one) where the highest bit in which their
     /// codes differ turns from 0 to 1; items of one code split in the middle.
     fn split(&self, range: Range<usize>) -> [Range<usize>; 2] {
@@ -162,6 +162,7 @@ impl<R, B: Fn(&R) -> Aabb> Morton<'_, R, B> {
         [range.start..range.start + mid, range.start + mid..range.end]
     }
 
+    /// The box of the items in `slots`.
     fn leaf_bounds(&self, slots: Range<usize>) -> Aabb {
         let mut b = Aabb::EMPTY;
         for item in &self.records[slots] {

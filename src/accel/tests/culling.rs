@@ -694,6 +694,7 @@ fn large_scenes_lose_no_hit_or_occluder() {
 /// out).
 #[test]
 fn a_hierarchy_from_the_morton_order_loses_no_hit() {
+    const _: () = assert!(300_000 > crate::accel::bvh::MORTON_ABOVE);
     let scene = crate::scene::many_scene(300_000);
     let spheres = &scene.spheres;
     let set = Spheres::new(spheres);
