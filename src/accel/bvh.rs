@@ -1707,13 +1707,4 @@ mod tests {
             assert_eq!(items[999] == 500, last, "width {width}");
         }
     }
-
-    /// A code's bits: x's, y's and z's in turn from the highest.
-    #[test]
-    fn spread_puts_a_coordinate_s_bits_three_apart() {
-        assert_eq!(morton::spread(0), 0);
-        assert_eq!(morton::spread(0b1011), 0b1_000_001_001);
-        assert_eq!(morton::spread(0x3ff), 0x0924_9249);
-        assert_eq!(morton::spread(0x7ff), 0x0924_9249, "above 10 bits, dropped");
-    }
 }

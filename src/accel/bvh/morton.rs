@@ -130,7 +130,7 @@ fn centres_box(len: usize, centre: impl Fn(usize) -> Option<Vec3A> + Sync) -> Aa
 }
 
 /// Spreads the low 10 bits of `x` to every third bit.
-pub(super) fn spread(x: u32) -> u32 {
+fn spread(x: u32) -> u32 {
     let mut x = x & 0x3ff;
     x = (x | x << 16) & 0x0300_00ff;
     x = (x | x << 8) & 0x0300_f00f;
@@ -205,5 +205,36 @@ impl<R, B: Fn(&R) -> Aabb> SortedItems<'_, R, B> {
         lanes.iter().for_each(|(lane, _, _)| b.grow(lane));
         out[me] = wide_node_of(lanes.into_iter());
         (me as u32, b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A step on x is the code's bit 2, on y bit 1, on z bit 0; the far corner of the
+    /// grid has every bit of 30; the corners' steps round down.
+    #[test]
+    fn a_code_interleaves_the_steps_x_first() {
+        let grid = Grid::over(&Aabb {
+            min: Vec3A::ZERO,
+            max: Vec3A::splat(Grid::STEPS * 2.0),
+        });
+        assert_eq!(grid.code(Vec3A::new(2.0, 0.0, 0.0)), 0b100);
+        assert_eq!(grid.code(Vec3A::new(0.0, 2.0, 0.0)), 0b010);
+        assert_eq!(grid.code(Vec3A::new(0.0, 0.0, 3.9)), 0b001);
+        assert_eq!(grid.code(Vec3A::new(4.0, 2.0, 6.0)), 0b101_011);
+        assert_eq!(grid.code(Vec3A::splat(Grid::STEPS * 2.0)), (1 << 30) - 1);
+        // Outside the box, the nearest step.
+        assert_eq!(grid.code(Vec3A::splat(-5.0)), 0);
+    }
+
+    /// Bit i of a step goes to bit 3i, for its 10 low bits.
+    #[test]
+    fn spread_puts_a_coordinate_s_bits_three_apart() {
+        assert_eq!(spread(0), 0);
+        assert_eq!(spread(0b1011), 0b1_000_001_001);
+        assert_eq!(spread(0x3ff), 0x0924_9249);
+        assert_eq!(spread(0x7ff), 0x0924_9249, "above 10 bits, dropped");
     }
 }
