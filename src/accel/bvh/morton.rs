@@ -53,9 +53,8 @@ pub(super) fn build<R: Send>(
     // The records in that order, gathered in one tight loop whose loads overlap; the
     // leaves' boxes are then read from them in order.
     let records: Vec<R> = keyed.par_iter().map(|&(_, k)| record(k as usize)).collect();
-    let codes: Vec<u32> = keyed.into_iter().map(|(code, _)| code).collect();
     let tree = SortedItems {
-        codes: &codes,
+        keyed: &keyed,
         records: &records,
         bounds: &bounds,
     };
@@ -141,7 +140,8 @@ fn spread(x: u32) -> u32 {
 
 /// The items sorted by their codes, as the nodes are made from them.
 struct SortedItems<'a, R, B> {
-    codes: &'a [u32],
+    /// Each item's code and index, sorted.
+    keyed: &'a [(u32, u32)],
     /// The items' records, in the codes' order.
     records: &'a [R],
     bounds: &'a B,
@@ -151,13 +151,13 @@ impl<R, B: Fn(&R) -> Aabb> SortedItems<'_, R, B> {
     /// Splits the slots `range` (more than one) where the highest bit in which their
     /// codes differ turns from 0 to 1; items of one code split in the middle.
     fn split(&self, range: Range<usize>) -> [Range<usize>; 2] {
-        let codes = &self.codes[range.clone()];
-        let (first, last) = (codes[0], codes[codes.len() - 1]);
+        let keyed = &self.keyed[range.clone()];
+        let (first, last) = (keyed[0].0, keyed[keyed.len() - 1].0);
         let mid = if first == last {
-            codes.len() / 2
+            keyed.len() / 2
         } else {
             let bit = 31 - (first ^ last).leading_zeros();
-            codes.partition_point(|&c| c >> bit & 1 == 0)
+            keyed.partition_point(|&(c, _)| c >> bit & 1 == 0)
         };
         [range.start..range.start + mid, range.start + mid..range.end]
     }
