@@ -266,20 +266,11 @@ impl Bvh {
             return;
         }
         // Finite reciprocals: a zero direction component would give 0·∞ = NaN.
-        let finite = |x: f32| {
-            if x.is_finite() {
-                x
-            } else {
-                f32::MAX.copysign(x)
-            }
-        };
         let inv = [finite(inv_d.x), finite(inv_d.y), finite(inv_d.z)];
         let o4 = [f32x4::splat(o.x), f32x4::splat(o.y), f32x4::splat(o.z)];
         let inv4 = inv.map(f32x4::splat);
-        // Entries: (node, 0) or (first item, items) of a leaf, with the distance at
-        // which the ray enters its box. Not zeroed: a zeroed array costs more than the
-        // traversal of a short ray.
-        let mut stack: ArrayVec<(u32, u32, f32), STACK> = ArrayVec::new();
+        // Not zeroed: a zeroed array costs more than the traversal of a short ray.
+        let mut stack = WalkStack::new();
         stack.push((0, 0, 0.0));
         while let Some((index, count, t_enter)) = stack.pop() {
             if t_enter > t_max {
@@ -311,56 +302,133 @@ impl Bvh {
                 hit |= (near4.cmp_le(far4).move_mask() as u32) << (4 * g);
                 near[4 * g..4 * g + 4].copy_from_slice(&near4.to_array());
             }
-            hit &= u32::from(n.used);
-            if hit == 0 {
+            push_nearest_last(&mut stack, n, hit & u32::from(n.used), &near);
+        }
+    }
+}
+
+/// A reciprocal direction component made finite: a zero component gives ±∞, and
+/// 0·∞ = NaN in the slab test.
+#[inline(always)]
+fn finite(x: f32) -> f32 {
+    if x.is_finite() {
+        x
+    } else {
+        f32::MAX.copysign(x)
+    }
+}
+
+/// A walk's waiting entries: (node, 0) or (first item, items) of a leaf, with the
+/// distance at which the ray enters its box.
+type WalkStack = ArrayVec<(u32, u32, f32), STACK>;
+
+/// Pushes the children of node `n` whose lanes are set in `hit` onto `stack`, farthest
+/// first by their entry distances `near`, leaves and inner nodes alike: the nearest
+/// comes off first, so hits are found nearest first and prune the rest (visiting
+/// leaves at once would find farther hits first, each a wasted exact test).
+#[inline(always)]
+fn push_nearest_last(stack: &mut WalkStack, n: &WideNode, hit: u32, near: &[f32; WIDTH]) {
+    if hit == 0 {
+        return;
+    }
+    let mut push = |lane: usize| {
+        stack.push((n.child[lane], u32::from(n.count[lane]), near[lane]));
+    };
+    let first = hit.trailing_zeros() as usize;
+    let rest = hit & (hit - 1);
+    if rest == 0 {
+        push(first);
+        return;
+    }
+    let second = rest.trailing_zeros() as usize;
+    if rest & (rest - 1) == 0 {
+        // Two children, the common case below the top: one comparison.
+        let (far, near_lane) = if near[first] < near[second] {
+            (second, first)
+        } else {
+            (first, second)
+        };
+        push(far);
+        push(near_lane);
+        return;
+    }
+    let mut order = [first, second, 0, 0, 0, 0, 0, 0];
+    let mut k = 2;
+    let mut more = rest & (rest - 1);
+    while more != 0 {
+        order[k] = more.trailing_zeros() as usize;
+        more &= more - 1;
+        k += 1;
+    }
+    let order = &mut order[..k];
+    // Insertion sort, farthest first: at most `WIDTH` lanes, rarely more than three
+    // (a library sort is not inlined and costs more than the node test).
+    for a in 1..k {
+        let mut b = a;
+        while b > 0 && near[order[b - 1]] < near[order[b]] {
+            order.swap(b - 1, b);
+            b -= 1;
+        }
+    }
+    for &lane in order.iter() {
+        push(lane);
+    }
+}
+
+impl Bvh {
+    /// [`Bvh::traverse`] for a bundle of rays from one origin `o` whose reciprocal
+    /// directions lie, axis by axis, within `[inv_lo, inv_hi]`: calls `visit(slot)` for
+    /// every item whose box any of the rays may meet within `[0, t_max]`, nearest boxes
+    /// first (by the bundle's nearest entry); `visit` returns the bundle's new `t_max`
+    /// (the largest of its rays' bounds). A box's slab distances are products
+    /// `(plane − o)·inv`, and a rounded product is monotone in `inv`: the bundle's
+    /// interval of them holds every ray's, so the test passes every box a ray's own
+    /// test passes.
+    pub(super) fn traverse_bundle(
+        &self,
+        o: Vec3,
+        inv_lo: Vec3,
+        inv_hi: Vec3,
+        mut visit: impl FnMut(u32) -> f32,
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let o4 = [o.x, o.y, o.z].map(f32x4::splat);
+        let lo4 = [inv_lo.x, inv_lo.y, inv_lo.z].map(|x| f32x4::splat(finite(x)));
+        let hi4 = [inv_hi.x, inv_hi.y, inv_hi.z].map(|x| f32x4::splat(finite(x)));
+        let mut t_max = f32::INFINITY;
+        let mut stack = WalkStack::new();
+        stack.push((0, 0, 0.0));
+        while let Some((index, count, t_enter)) = stack.pop() {
+            if t_enter > t_max {
                 continue;
             }
-            // Children onto the stack farthest first, leaves and inner nodes alike: the
-            // nearest comes off first, so hits are found nearest first and prune the
-            // rest (visiting leaves at once would find farther hits first, each a
-            // wasted exact test).
-            let push = |stack: &mut ArrayVec<_, STACK>, lane: usize| {
-                stack.push((n.child[lane], u32::from(n.count[lane]), near[lane]));
-            };
-            let first = hit.trailing_zeros() as usize;
-            let rest = hit & (hit - 1);
-            if rest == 0 {
-                push(&mut stack, first);
-                continue;
-            }
-            let second = rest.trailing_zeros() as usize;
-            if rest & (rest - 1) == 0 {
-                // Two children, the common case below the top: one comparison.
-                let (far, near_lane) = if near[first] < near[second] {
-                    (second, first)
-                } else {
-                    (first, second)
-                };
-                push(&mut stack, far);
-                push(&mut stack, near_lane);
-                continue;
-            }
-            let mut order = [first, second, 0, 0, 0, 0, 0, 0];
-            let mut k = 2;
-            let mut more = rest & (rest - 1);
-            while more != 0 {
-                order[k] = more.trailing_zeros() as usize;
-                more &= more - 1;
-                k += 1;
-            }
-            let order = &mut order[..k];
-            // Insertion sort, farthest first: at most `WIDTH` lanes, rarely more than
-            // three (a library sort is not inlined and costs more than the node test).
-            for a in 1..k {
-                let mut b = a;
-                while b > 0 && near[order[b - 1]] < near[order[b]] {
-                    order.swap(b - 1, b);
-                    b -= 1;
+            if count > 0 {
+                for slot in index..index + count {
+                    t_max = visit(slot);
                 }
+                continue;
             }
-            for &lane in order.iter() {
-                push(&mut stack, lane);
+            let n = &self.nodes[index as usize];
+            let mut hit = 0;
+            let mut near = [0.0f32; WIDTH];
+            for g in 0..GROUPS {
+                let mut near4 = f32x4::splat(0.0);
+                let mut far4 = f32x4::splat(t_max);
+                for a in 0..3 {
+                    // The four products of the slab's planes and the interval's ends
+                    // bound every ray's distances to the planes.
+                    let (m0, m1) = (n.min[a][g] - o4[a], n.max[a][g] - o4[a]);
+                    let (t0, t1) = (m0 * lo4[a], m0 * hi4[a]);
+                    let (t2, t3) = (m1 * lo4[a], m1 * hi4[a]);
+                    near4 = near4.fast_max(t0.fast_min(t1).fast_min(t2.fast_min(t3)));
+                    far4 = far4.fast_min(t0.fast_max(t1).fast_max(t2.fast_max(t3)));
+                }
+                hit |= (near4.cmp_le(far4).move_mask() as u32) << (4 * g);
+                near[4 * g..4 * g + 4].copy_from_slice(&near4.to_array());
             }
+            push_nearest_last(&mut stack, n, hit & u32::from(n.used), &near);
         }
     }
 }
@@ -1269,6 +1337,121 @@ mod tests {
         }
         println!("{met} leaves met, {missed} missed");
         assert!(met > 3000 && missed > 500_000, "{met} {missed}");
+    }
+
+    /// A bundle's walk visits every item that any of its rays' own walks visits, once,
+    /// nearest boxes first by the bundle's entry (each leaf's entry no smaller than
+    /// the last's, up to the node boxes' overlap); and bundles of near directions visit
+    /// few leaves besides (the interval's boxes grow with the spread of the
+    /// directions). Bundles of all kinds: near directions, directions of every sign,
+    /// and directions with zero components.
+    #[test]
+    fn the_bundle_walk_visits_every_item_its_rays_visit() {
+        for_both(the_bundle_walk_visits_every_item_its_rays_visit_with);
+    }
+
+    fn the_bundle_walk_visits_every_item_its_rays_visit_with(build: Builder) {
+        let mut rng = rand_mt::Mt64::new(17);
+        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let boxes: Vec<Aabb> = (0..3000)
+            .map(|_| {
+                let c = Vec3A::new(unit() as f32, unit() as f32, unit() as f32) * 60.0;
+                let h = Vec3A::new(unit() as f32, unit() as f32, unit() as f32) * 1.5;
+                Aabb {
+                    min: c - h,
+                    max: c + h,
+                }
+            })
+            .collect();
+        let (bvh, _) = build(boxes.len(), &|k| boxes[k]);
+        let (mut own, mut own_near, mut visited_near) = (0usize, 0usize, 0usize);
+        for b in 0..600 {
+            let o = DVec3::new(unit(), unit(), unit()) * 80.0 - 10.0;
+            let centre = DVec3::new(unit(), unit(), unit()) * 2.0 - 1.0;
+            let near = b % 3 == 0 && b % 4 != 1;
+            let dirs: Vec<Vec3> = (0..1 + b % 8)
+                .map(|i| {
+                    let mut d = if near {
+                        centre + DVec3::new(unit(), unit(), unit()) * 0.01
+                    } else {
+                        DVec3::new(unit(), unit(), unit()) * 2.0 - 1.0
+                    };
+                    if b % 4 == 1 {
+                        d[i % 3] = 0.0;
+                    }
+                    d.normalize().as_vec3()
+                })
+                .collect();
+            let mut each = vec![false; boxes.len()];
+            for d in &dirs {
+                bvh.traverse(o.as_vec3(), d.recip(), f32::INFINITY, |slot, _| {
+                    each[slot as usize] = true;
+                    None
+                });
+            }
+            let (inv_lo, inv_hi) = dirs
+                .iter()
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), d| {
+                    (lo.min(d.recip()), hi.max(d.recip()))
+                });
+            let mut visits = vec![0u32; boxes.len()];
+            bvh.traverse_bundle(o.as_vec3(), inv_lo, inv_hi, |slot| {
+                visits[slot as usize] += 1;
+                f32::INFINITY
+            });
+            assert!(visits.iter().all(|&v| v <= 1), "bundle {b}: an item twice");
+            for (slot, &met) in each.iter().enumerate() {
+                assert!(
+                    !met || visits[slot] == 1,
+                    "bundle {b}: slot {slot} not visited"
+                );
+            }
+            let count = |v: &[bool]| v.iter().filter(|&&m| m).count();
+            own += count(&each);
+            if near {
+                own_near += count(&each);
+                visited_near += visits.iter().filter(|&&v| v == 1).count();
+            }
+        }
+        println!(
+            "{own} items met by the rays; near bundles: {own_near} met, {visited_near} visited"
+        );
+        assert!(own > 10_000 && own_near > 800, "{own} {own_near}");
+        assert!(
+            10 * visited_near < 12 * own_near,
+            "{visited_near} of {own_near}"
+        );
+    }
+
+    /// A bundle's walk stops where its bound says: given a bound below every box's
+    /// entry, it visits nothing past the first leaf; and a leaf whose bundle entry
+    /// lies beyond the bound returned is not visited.
+    #[test]
+    fn the_bundle_walk_stops_at_the_bound_its_visits_return() {
+        let boxes: Vec<Aabb> = (0..64)
+            .map(|k| {
+                let c = Vec3A::new(0.0, 0.0, 4.0 * k as f32 + 10.0);
+                Aabb {
+                    min: c - 1.0,
+                    max: c + 1.0,
+                }
+            })
+            .collect();
+        for build in [binned as Builder, morton] {
+            let (bvh, items) = build(boxes.len(), &|k| boxes[k]);
+            let d = Vec3::new(0.0, 0.0, 1.0);
+            let mut visited = Vec::new();
+            bvh.traverse_bundle(Vec3::ZERO, d.recip(), d.recip(), |slot| {
+                visited.push(items[slot as usize]);
+                // A hit at the box's near face: nothing farther can be nearer.
+                4.0 * items[slot as usize] as f32 + 9.0
+            });
+            // The first box, and the others of its leaf at most.
+            assert!(
+                visited.contains(&0) && visited.len() <= MAX_LEAF,
+                "{visited:?}"
+            );
+        }
     }
 
     /// The segment the walk covers is closed: the boxes it touches only at its ends,

@@ -84,6 +84,12 @@ pub(crate) struct EyeGrid {
 }
 
 impl EyeGrid {
+    /// Whether the eye has no grid: its primary rays walk the hierarchy in bundles
+    /// ([`Spheres::closest_bundle`]).
+    pub(crate) fn walks_in_bundles(&self) -> bool {
+        self.grid.is_none()
+    }
+
     /// The grid, when the eye's shortcuts ([`Spheres::closest_from_eye`],
     /// [`Spheres::eye_run`]) apply to a scene of `spheres` spheres: an eye grid (with the
     /// per-sphere records, even when there is no sphere), and the eye inside no sphere

@@ -8,6 +8,7 @@ use glam::{DVec3, Vec3};
 
 use super::row::{self, RowCamera, RUN};
 use super::{RayCounts, SampleTracer};
+use crate::accel::BUNDLE;
 use crate::accel::{EyeGrid, Hit, Query, Spheres, ViewPyramid};
 use crate::camera::Camera;
 use crate::model::{self, Branches, Side};
@@ -348,6 +349,30 @@ impl SampleTracer for FastTracer {
         // `trace` would return it, without the per-ray query; else one cell lookup
         // serves the run.
         let spheres = &self.compiled.spheres;
+        if self.eye.walks_in_bundles() {
+            // No eye grid: the run's rays walk the hierarchy as one bundle.
+            let mut dirs = [Vec3::ZERO; BUNDLE];
+            let mut skipped = Skipped::default();
+            for (s, out) in s.chunks(BUNDLE).zip(out.chunks_mut(BUNDLE)) {
+                for (part, dirs) in s.chunks(RUN).zip(dirs.chunks_exact_mut(RUN)) {
+                    camera.directions(part, dirs.try_into().expect("RUN directions"));
+                }
+                let dirs = &dirs[..s.len()];
+                let mut hits = [None; BUNDLE];
+                let hits = &mut hits[..s.len()];
+                spheres.closest_bundle(self.origin, dirs, hits);
+                for ((o, d), h) in out.chunks_mut(2).zip(dirs.chunks(2)).zip(hits.chunks(2)) {
+                    if o.len() == 2 {
+                        counts.primary += 2;
+                        [o[0], o[1]] = self.shade_pair([d[0], d[1]], &[h[0], h[1]], counts);
+                    } else {
+                        counts.primary += 1;
+                        o[0] = self.shade(d[0], h[0], 0, 1.0, counts, &mut skipped);
+                    }
+                }
+            }
+            return;
+        }
         let mut dirs = [Vec3::ZERO; RUN];
         for (s, out) in s.chunks(RUN).zip(out.chunks_mut(RUN)) {
             camera.directions(s, &mut dirs);
@@ -401,6 +426,44 @@ mod tests {
     /// The tracer builds its eye's grid for the camera's view: a ball behind the camera
     /// is left out of it (no primary ray could meet it), while the balls in front are
     /// listed.
+    /// Above the eye grid's size the rows' primary rays walk the hierarchy in bundles:
+    /// each pixel of a row gets the colour `sample` gives it alone, to the bit, over
+    /// the peers' scene of 70,000 balls (sky, small balls of every material, the big
+    /// glass, mirror and diffuse balls, the ground), in rows of 317 pixels (runs of
+    /// eight and one of five).
+    #[test]
+    fn rows_in_bundles_give_each_pixel_its_own_colour() {
+        let scene = crate::scene::many_scene(70_000);
+        let (width, height) = (317u32, 60u32);
+        let tracer = FastTracer::new(&scene, &scene.camera(width, height).unwrap(), 5);
+        assert!(tracer.eye.walks_in_bundles());
+        let s: Vec<f32> = (0..width)
+            .map(|x| (x as f32 + 0.5) / width as f32)
+            .collect();
+        let mut counts = RayCounts::default();
+        let mut sky = 0;
+        for j in 0..height {
+            let t = (j as f32 + 0.5) / height as f32;
+            let mut row = vec![Vec3::ZERO; s.len()];
+            tracer.sample_row(&s, t, &mut row, &mut counts);
+            for (&s, got) in s.iter().zip(row) {
+                let want = tracer.sample(s, t, &mut counts);
+                assert_eq!(got.to_array(), want.to_array(), "pixel at ({s}, {t})");
+                let dir = model::primary_direction(
+                    tracer.corner,
+                    tracer.horizontal,
+                    tracer.vertical,
+                    s,
+                    t,
+                );
+                sky += usize::from(
+                    got == model::sky(dir, tracer.compiled.sky_down, tracer.compiled.sky_up),
+                );
+            }
+        }
+        assert!(sky > 100 && sky < 15_000, "{sky} pixels of sky");
+    }
+
     #[test]
     fn the_eye_s_grid_leaves_out_a_ball_behind_the_camera() {
         let mut scene = hw3_scene(HW3_DEFAULT_SEED);

@@ -15,7 +15,7 @@ use crate::accel::{Hit, InsideLists, Spheres};
 use crate::scene::Sphere;
 
 /// Random spheres: radius 10^U(−3,3), centre 10^U(−1,4) from the origin.
-fn world() -> impl Strategy<Value = Vec<Sphere>> {
+pub(super) fn world() -> impl Strategy<Value = Vec<Sphere>> {
     prop::collection::vec(
         (
             log_uniform(-3.0, 3.0),

@@ -1,10 +1,11 @@
 //! Tests of the queries of [`Spheres`] against independent `f64` computations: the
 //! rounding of spawn points and distances ([`intersection`]), refraction through a ball
-//! ([`refraction`]), the culling of the hierarchy and the grids ([`culling`]) and the
-//! work it skips ([`work`]).
+//! ([`refraction`]), the culling of the hierarchy and the grids ([`culling`]), bundles
+//! of primary rays ([`bundle`]) and the work it skips ([`work`]).
 //! Random cases come from proptest with log-uniform radii and distances and a fixed
 //! seed, so the printed figures reproduce.
 
+mod bundle;
 mod culling;
 mod intersection;
 mod quick;
