@@ -237,6 +237,51 @@ fn cells_of(
     }
 }
 
+/// A range of a grid's cells with their ends (`offsets`, the first cell's at
+/// `first_cell`) and their entries (`items`, the first at `first_item`), which one
+/// thread fills.
+struct CellRange<'a, T> {
+    first_cell: u32,
+    offsets: &'a mut [u32],
+    first_item: u32,
+    items: &'a mut [Listed<T>],
+}
+
+/// `offsets` (each cell's end, the cells' entries counted) and `items` cut into `parts`
+/// ranges of cells of about as many entries each: their fills are independent.
+fn cell_ranges<'a, T>(
+    offsets: &'a mut [u32],
+    items: &'a mut [Listed<T>],
+    parts: usize,
+) -> Vec<CellRange<'a, T>> {
+    let total = items.len() as u64;
+    let mut ranges = Vec::with_capacity(parts);
+    let (mut offsets, mut items) = (offsets, items);
+    let (mut first_cell, mut first_item) = (0u32, 0u32);
+    for p in 1..=parts as u64 {
+        // The cells up to the first whose end reaches the part's share of the entries.
+        let share = (total * p / parts as u64) as u32;
+        let cells = if p == parts as u64 {
+            offsets.len()
+        } else {
+            offsets.partition_point(|&end| end < share)
+        };
+        let (these, rest) = offsets.split_at_mut(cells);
+        let entries = these.last().map_or(first_item, |&end| end) - first_item;
+        let (those, others) = items.split_at_mut(entries as usize);
+        ranges.push(CellRange {
+            first_cell,
+            offsets: these,
+            first_item,
+            items: those,
+        });
+        first_cell += cells as u32;
+        first_item += entries;
+        (offsets, items) = (rest, others);
+    }
+    ranges
+}
+
 /// Widening of each sphere's range in face coordinates (cells are `2/n` wide): covers
 /// the rounding of query directions many times over.
 const WIDEN: f64 = 1e-4;
@@ -432,16 +477,27 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
             end += *offset;
             *offset = end;
         }
-        // Filled with any entry first (every place is written below).
-        let mut items = match sorted.first() {
-            Some(&(_, first)) => vec![first; end as usize],
+        // Filled with any entry first (every place is written below), on the pool's
+        // threads: the fill is the first touch of fresh pages, whose faults then
+        // overlap.
+        let mut items: Vec<Listed<T>> = match sorted.first() {
+            Some(&(_, first)) => (0..end).into_par_iter().map(|_| first).collect(),
             None => Vec::new(),
         };
-        for &(cell, place) in runs.iter().rev().flat_map(|run| run.pairs.iter().rev()) {
-            let start = &mut offsets[cell as usize];
-            *start -= 1;
-            items[*start as usize] = sorted[place as usize].1;
-        }
+        let pairs = || runs.iter().rev().flat_map(|run| run.pairs.iter().rev());
+        let parts = cell_ranges(&mut offsets, &mut items, rayon::current_num_threads());
+        parts.into_par_iter().for_each(|part| {
+            for &(cell, place) in pairs() {
+                let Some(start) = part
+                    .offsets
+                    .get_mut(cell.wrapping_sub(part.first_cell) as usize)
+                else {
+                    continue;
+                };
+                *start -= 1;
+                part.items[(*start - part.first_item) as usize] = sorted[place as usize].1;
+            }
+        });
         let wide = runs
             .iter()
             .flat_map(|run| &run.wide)
