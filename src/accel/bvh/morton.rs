@@ -58,7 +58,10 @@ pub(super) fn build<R: Send>(
         records: &records,
         bounds: &bounds,
     };
-    let mut nodes = Vec::new();
+    // Room for a node every `WIDTH − 1` items, so that the vector is not copied as it
+    // grows: the codes' splits leave many leaves of one item (a million spheres make
+    // 127,443 nodes, 32 MB). The room not used is never touched.
+    let mut nodes = Vec::with_capacity(len / (WIDTH - 1) + 1);
     if len > 0 {
         if len <= MAX_LEAF {
             // A single leaf: a node of one child.
