@@ -87,15 +87,13 @@ const QUICK_SLACK: f32 = 1.0 / (1 << 18) as f32;
 /// cells leave more of them empty, so more runs of sky pixels skip the query, and put
 /// more runs of pixels in one cell to share its lookup; smaller cells keep a primary
 /// ray's list short. The steps grow with the scene, each at the fastest resolution
-/// measured for its size.
+/// measured for its size (up to [`EYE_GRID_UP_TO`] spheres: above, the eye has none).
 fn eye_resolution(spheres: usize) -> u32 {
     match spheres {
         0..=64 => 12,
         65..=256 => 32,
         257..=4096 => 64,
-        4097..=65536 => 128,
-        65537..=262144 => 256,
-        _ => 384,
+        _ => 128,
     }
 }
 
