@@ -8,9 +8,7 @@
 use glam::{DVec3, Vec3};
 use wide::{f32x8, CmpGt, CmpLe, CmpLt};
 
-use super::{
-    crossing_of, round_up, unit64, Best, Hit, Query, Ray, Spheres, LINE_SLACK, QUICK_SLACK, U32,
-};
+use super::{crossing_of, unit64, Best, Hit, Query, Ray, Spheres, LINE_SLACK, QUICK_SLACK, U32};
 
 /// The most rays of a bundle: a lane each of the quick test.
 pub(crate) const BUNDLE: usize = 8;
@@ -19,7 +17,9 @@ impl Spheres {
     /// The closest hits of the rays from `origin` with unit directions `dirs` (at most
     /// [`BUNDLE`]; rays with no spawn sphere, such as primary rays), into `hits`: the
     /// same hits as [`Spheres::closest`] of each ray, each sphere the walk reaches
-    /// tested for each ray as that walk tests it.
+    /// tested for each ray as that walk tests it (of two spheres crossed at exactly
+    /// one distance, each walk keeps the first it meets: a leaf's spheres come in one
+    /// order to both).
     pub(crate) fn closest_bundle(&self, origin: DVec3, dirs: &[Vec3], hits: &mut [Option<Hit>]) {
         assert!(!dirs.is_empty() && dirs.len() <= BUNDLE && hits.len() == dirs.len());
         // Lanes past the last ray repeat it; their results are not read.
@@ -52,13 +52,7 @@ impl Spheres {
                     if let Some((t, entering, normal)) =
                         crossing_of(k, &s.exact, &rays[i], d64[i], best[i].t)
                     {
-                        t_max[i] = round_up(t);
-                        best[i] = Best {
-                            t,
-                            k,
-                            entering,
-                            normal,
-                        };
+                        t_max[i] = best[i].take(t, k, entering, normal).unwrap_or(t_max[i]);
                     }
                 }
                 lanes.largest(&t_max)

@@ -889,6 +889,27 @@ mod tests {
         }
     }
 
+    /// Uniform numbers in [0, 1) from a Mersenne twister seeded with `seed`.
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut rng = rand_mt::Mt64::new(seed);
+        move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// `count` boxes with centres uniform in [0, 60)³ and half sides uniform up to
+    /// `half`.
+    fn random_boxes(unit: &mut impl FnMut() -> f64, count: usize, half: f32) -> Vec<Aabb> {
+        (0..count)
+            .map(|_| {
+                let c = Vec3A::new(unit() as f32, unit() as f32, unit() as f32) * 60.0;
+                let h = Vec3A::new(unit() as f32, unit() as f32, unit() as f32) * half;
+                Aabb {
+                    min: c - h,
+                    max: c + h,
+                }
+            })
+            .collect()
+    }
+
     /// Each leaf of the tree: the union of its items' boxes (from `boxes`, not the
     /// tree's own bounds) and its slots.
     fn leaves_of(bvh: &Bvh, items: &[u32], boxes: &[Aabb]) -> Vec<(Aabb, std::ops::Range<usize>)> {
@@ -1268,18 +1289,8 @@ mod tests {
     }
 
     fn the_walk_meets_the_leaves_the_ray_meets_and_no_others_with(build: Builder) {
-        let mut rng = rand_mt::Mt64::new(9);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-        let boxes: Vec<Aabb> = (0..3000)
-            .map(|_| {
-                let c = Vec3A::new(unit() as f32, unit() as f32, unit() as f32) * 60.0;
-                let h = Vec3A::new(unit() as f32, unit() as f32, unit() as f32) * 3.0;
-                Aabb {
-                    min: c - h,
-                    max: c + h,
-                }
-            })
-            .collect();
+        let mut unit = uniform(9);
+        let boxes = random_boxes(&mut unit, 3000, 3.0);
         let (bvh, items) = build(boxes.len(), &|k| boxes[k]);
         let leaves = leaves_of(&bvh, &items, &boxes);
         // How far inside the box the segment runs: its length inside, or, when it
@@ -1339,30 +1350,18 @@ mod tests {
         assert!(met > 3000 && missed > 500_000, "{met} {missed}");
     }
 
-    /// A bundle's walk visits every item that any of its rays' own walks visits, once,
-    /// nearest boxes first by the bundle's entry (each leaf's entry no smaller than
-    /// the last's, up to the node boxes' overlap); and bundles of near directions visit
-    /// few leaves besides (the interval's boxes grow with the spread of the
-    /// directions). Bundles of all kinds: near directions, directions of every sign,
-    /// and directions with zero components.
+    /// A bundle's walk visits every item that any of its rays' own walks visits, once;
+    /// and bundles of near directions visit few items besides (the interval's boxes
+    /// grow with the spread of the directions). Bundles of all kinds: near
+    /// directions, directions of every sign, and directions with zero components.
     #[test]
     fn the_bundle_walk_visits_every_item_its_rays_visit() {
         for_both(the_bundle_walk_visits_every_item_its_rays_visit_with);
     }
 
     fn the_bundle_walk_visits_every_item_its_rays_visit_with(build: Builder) {
-        let mut rng = rand_mt::Mt64::new(17);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-        let boxes: Vec<Aabb> = (0..3000)
-            .map(|_| {
-                let c = Vec3A::new(unit() as f32, unit() as f32, unit() as f32) * 60.0;
-                let h = Vec3A::new(unit() as f32, unit() as f32, unit() as f32) * 1.5;
-                Aabb {
-                    min: c - h,
-                    max: c + h,
-                }
-            })
-            .collect();
+        let mut unit = uniform(17);
+        let boxes = random_boxes(&mut unit, 3000, 1.5);
         let (bvh, _) = build(boxes.len(), &|k| boxes[k]);
         let (mut own, mut own_near, mut visited_near) = (0usize, 0usize, 0usize);
         for b in 0..600 {

@@ -32,6 +32,7 @@ impl RowCamera {
     }
 
     /// `model::primary_direction` of `s` (at most [`RUN`] film abscissae) into `out`.
+    #[inline(always)]
     pub fn directions(&self, s: &[f32], out: &mut [Vec3; RUN]) {
         debug_assert!(!s.is_empty() && s.len() <= RUN);
         let last = s[s.len() - 1];
