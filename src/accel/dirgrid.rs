@@ -828,9 +828,9 @@ mod tests {
     use glam::{DVec2, DVec3};
 
     use super::{
-        cell_places, coarser, face_rect, fewest_entries, most_entries, nearest_first, only_face,
-        silhouette_rect, DirGrid, COARSEST, ENTRIES_ANY, ENTRIES_PER_SPHERE, MOST_WIDE,
-        SPHERES_PER_RUN, WIDEN,
+        cell_places, cell_ranges, coarser, face_rect, fewest_entries, most_entries, nearest_first,
+        only_face, silhouette_rect, DirGrid, Listed, COARSEST, ENTRIES_ANY, ENTRIES_PER_SPHERE,
+        MOST_WIDE, SPHERES_PER_RUN, WIDEN,
     };
 
     /// What a grid lists, against the spheres' geometry in `f64` and directions drawn at
@@ -1320,6 +1320,71 @@ mod tests {
         let ks = |g: &DirGrid| g.items.iter().map(|e| e.k).collect::<Vec<_>>();
         assert_eq!(ks(&within), ks(&all));
         assert!(build(entries - 1).is_none());
+    }
+
+    /// The ranges that fill a grid's cells on several threads cover every cell and
+    /// entry once, in order, each range's entries those of its cells, and share the
+    /// entries about evenly: no range more than a cell's entries past its share.
+    #[test]
+    fn cell_ranges_cover_the_cells_in_order_and_share_the_entries() {
+        let mut rng = rand_mt::Mt64::new(3);
+        for (cells, parts) in [(1, 1), (1, 3), (10, 2), (1000, 2), (1000, 3), (5000, 7)] {
+            // Cells of 0 to 20 entries, a tenth of them crowded (up to 200); the
+            // offsets hold each cell's end, and one more past the last.
+            let mut end = 0u32;
+            let mut offsets: Vec<u32> = (0..=cells)
+                .map(|c| {
+                    let r = rng.next_u64();
+                    if c < cells {
+                        let crowd = if r.is_multiple_of(10) {
+                            (r >> 8) % 200
+                        } else {
+                            0
+                        };
+                        end += (r % 21 + crowd) as u32;
+                    }
+                    end
+                })
+                .collect();
+            let ends = offsets.clone();
+            let entry = Listed {
+                k: 0,
+                near: 0.0,
+                data: (),
+            };
+            let mut items = vec![entry; end as usize];
+            let widest = ends
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .max()
+                .unwrap_or(0)
+                .max(ends[0]);
+            let ranges = cell_ranges(&mut offsets, &mut items, parts);
+            assert_eq!(ranges.len(), parts);
+            let (mut cell, mut item) = (0u32, 0u32);
+            for (p, range) in ranges.iter().enumerate() {
+                assert_eq!(
+                    (range.first_cell, range.first_item),
+                    (cell, item),
+                    "part {p}"
+                );
+                cell += range.offsets.len() as u32;
+                item += range.items.len() as u32;
+                if let Some(&last) = range.offsets.last() {
+                    assert_eq!(
+                        last, item,
+                        "part {p}: its entries end at its last cell's end"
+                    );
+                }
+                let share = u64::from(end) / parts as u64;
+                assert!(
+                    range.items.len() as u64 <= share + u64::from(widest),
+                    "part {p}: {} entries, a share of {share}",
+                    range.items.len()
+                );
+            }
+            assert_eq!((cell as usize, item), (cells + 1, end));
+        }
     }
 
     /// The grid of `n` cells a side around `centre` with at most `bound` entries, no
