@@ -467,7 +467,7 @@ mod tests {
     /// each pixel of a row gets the colour `sample` gives it alone, to the bit, over
     /// the peers' scene of 70,000 balls (sky, small balls of every material, the big
     /// glass, mirror and diffuse balls, the ground), in rows of 317 pixels (runs of
-    /// eight and one of five).
+    /// eight and one of five), one primary ray a pixel; 65,536 spheres keep the grid.
     #[test]
     fn rows_in_bundles_give_each_pixel_its_own_colour() {
         let scene = crate::scene::many_scene(70_000);
@@ -482,7 +482,13 @@ mod tests {
         for j in 0..height {
             let t = (j as f32 + 0.5) / height as f32;
             let mut row = vec![Vec3::ZERO; s.len()];
-            tracer.sample_row(&s, t, &mut row, &mut counts);
+            let mut row_counts = RayCounts::default();
+            tracer.sample_row(&s, t, &mut row, &mut row_counts);
+            assert_eq!(
+                row_counts.primary,
+                u64::from(width),
+                "a primary ray a pixel"
+            );
             for (&s, got) in s.iter().zip(row) {
                 let want = tracer.sample(s, t, &mut counts);
                 assert_eq!(got.to_array(), want.to_array(), "pixel at ({s}, {t})");
@@ -499,6 +505,10 @@ mod tests {
             }
         }
         assert!(sky > 100 && sky < 15_000, "{sky} pixels of sky");
+        // At the grid's size, the eye keeps its grid.
+        let scene = crate::scene::many_scene(65_532);
+        let tracer = FastTracer::new(&scene, &scene.camera(width, height).unwrap(), 5);
+        assert!(!tracer.eye.walks_in_bundles());
     }
 
     #[test]
