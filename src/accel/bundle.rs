@@ -34,9 +34,9 @@ impl Spheres {
         let d64 = rays.map(|ray| unit64(ray.d32));
         let lanes = Lanes::new(&rays, dirs.len());
         let (mut inv_lo, mut inv_hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        for d in dirs {
-            inv_lo = inv_lo.min(d.recip());
-            inv_hi = inv_hi.max(d.recip());
+        for inv in dirs.iter().map(|d| d.recip()) {
+            inv_lo = inv_lo.min(inv);
+            inv_hi = inv_hi.max(inv);
         }
         let mut best = [Best::NONE; BUNDLE];
         // Each ray's bound, as its own walk keeps it: its closest hit so far, rounded up.

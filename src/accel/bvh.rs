@@ -305,6 +305,62 @@ impl Bvh {
             push_nearest_last(&mut stack, n, hit & u32::from(n.used), &near);
         }
     }
+
+    /// [`Bvh::traverse`] for a bundle of rays from one origin `o` whose reciprocal
+    /// directions lie, axis by axis, within `[inv_lo, inv_hi]`: calls `visit(slot)` for
+    /// every item whose box any of the rays may meet within `[0, t_max]`, nearest boxes
+    /// first (by the bundle's nearest entry); `visit` returns the bundle's new `t_max`
+    /// (the largest of its rays' bounds). A box's slab distances are products
+    /// `(plane − o)·inv`, and a rounded product is monotone in `inv`: the bundle's
+    /// interval of them holds every ray's, so the test passes every box a ray's own
+    /// test passes.
+    pub(super) fn traverse_bundle(
+        &self,
+        o: Vec3,
+        inv_lo: Vec3,
+        inv_hi: Vec3,
+        mut visit: impl FnMut(u32) -> f32,
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let o4 = [o.x, o.y, o.z].map(f32x4::splat);
+        let lo4 = [inv_lo.x, inv_lo.y, inv_lo.z].map(|x| f32x4::splat(finite(x)));
+        let hi4 = [inv_hi.x, inv_hi.y, inv_hi.z].map(|x| f32x4::splat(finite(x)));
+        let mut t_max = f32::INFINITY;
+        let mut stack = WalkStack::new();
+        stack.push((0, 0, 0.0));
+        while let Some((index, count, t_enter)) = stack.pop() {
+            if t_enter > t_max {
+                continue;
+            }
+            if count > 0 {
+                for slot in index..index + count {
+                    t_max = visit(slot);
+                }
+                continue;
+            }
+            let n = &self.nodes[index as usize];
+            let mut hit = 0;
+            let mut near = [0.0f32; WIDTH];
+            for g in 0..GROUPS {
+                let mut near4 = f32x4::splat(0.0);
+                let mut far4 = f32x4::splat(t_max);
+                for a in 0..3 {
+                    // The four products of the slab's planes and the interval's ends
+                    // bound every ray's distances to the planes.
+                    let (m0, m1) = (n.min[a][g] - o4[a], n.max[a][g] - o4[a]);
+                    let (t0, t1) = (m0 * lo4[a], m0 * hi4[a]);
+                    let (t2, t3) = (m1 * lo4[a], m1 * hi4[a]);
+                    near4 = near4.fast_max(t0.fast_min(t1).fast_min(t2.fast_min(t3)));
+                    far4 = far4.fast_min(t0.fast_max(t1).fast_max(t2.fast_max(t3)));
+                }
+                hit |= (near4.cmp_le(far4).move_mask() as u32) << (4 * g);
+                near[4 * g..4 * g + 4].copy_from_slice(&near4.to_array());
+            }
+            push_nearest_last(&mut stack, n, hit & u32::from(n.used), &near);
+        }
+    }
 }
 
 /// A reciprocal direction component made finite: a zero component gives ±∞, and
@@ -372,64 +428,6 @@ fn push_nearest_last(stack: &mut WalkStack, n: &WideNode, hit: u32, near: &[f32;
     }
     for &lane in order.iter() {
         push(lane);
-    }
-}
-
-impl Bvh {
-    /// [`Bvh::traverse`] for a bundle of rays from one origin `o` whose reciprocal
-    /// directions lie, axis by axis, within `[inv_lo, inv_hi]`: calls `visit(slot)` for
-    /// every item whose box any of the rays may meet within `[0, t_max]`, nearest boxes
-    /// first (by the bundle's nearest entry); `visit` returns the bundle's new `t_max`
-    /// (the largest of its rays' bounds). A box's slab distances are products
-    /// `(plane − o)·inv`, and a rounded product is monotone in `inv`: the bundle's
-    /// interval of them holds every ray's, so the test passes every box a ray's own
-    /// test passes.
-    pub(super) fn traverse_bundle(
-        &self,
-        o: Vec3,
-        inv_lo: Vec3,
-        inv_hi: Vec3,
-        mut visit: impl FnMut(u32) -> f32,
-    ) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let o4 = [o.x, o.y, o.z].map(f32x4::splat);
-        let lo4 = [inv_lo.x, inv_lo.y, inv_lo.z].map(|x| f32x4::splat(finite(x)));
-        let hi4 = [inv_hi.x, inv_hi.y, inv_hi.z].map(|x| f32x4::splat(finite(x)));
-        let mut t_max = f32::INFINITY;
-        let mut stack = WalkStack::new();
-        stack.push((0, 0, 0.0));
-        while let Some((index, count, t_enter)) = stack.pop() {
-            if t_enter > t_max {
-                continue;
-            }
-            if count > 0 {
-                for slot in index..index + count {
-                    t_max = visit(slot);
-                }
-                continue;
-            }
-            let n = &self.nodes[index as usize];
-            let mut hit = 0;
-            let mut near = [0.0f32; WIDTH];
-            for g in 0..GROUPS {
-                let mut near4 = f32x4::splat(0.0);
-                let mut far4 = f32x4::splat(t_max);
-                for a in 0..3 {
-                    // The four products of the slab's planes and the interval's ends
-                    // bound every ray's distances to the planes.
-                    let (m0, m1) = (n.min[a][g] - o4[a], n.max[a][g] - o4[a]);
-                    let (t0, t1) = (m0 * lo4[a], m0 * hi4[a]);
-                    let (t2, t3) = (m1 * lo4[a], m1 * hi4[a]);
-                    near4 = near4.fast_max(t0.fast_min(t1).fast_min(t2.fast_min(t3)));
-                    far4 = far4.fast_min(t0.fast_max(t1).fast_max(t2.fast_max(t3)));
-                }
-                hit |= (near4.cmp_le(far4).move_mask() as u32) << (4 * g);
-                near[4 * g..4 * g + 4].copy_from_slice(&near4.to_array());
-            }
-            push_nearest_last(&mut stack, n, hit & u32::from(n.used), &near);
-        }
     }
 }
 

@@ -305,9 +305,9 @@ impl Spheres {
     ) -> (Spheres, EyeGrid) {
         let geometry = Arc::new(geometry_of(spheres));
         let list = geometry.as_slice();
-        // The lights' grids before the eye's: the build then ends on the eye grid,
-        // whose work on one thread alone (its counting sort) is the shorter, and the
-        // thread done with the hierarchy meanwhile shares its parallel parts.
+        // The lights' grids before the eye's (which scenes above `EYE_GRID_UP_TO`
+        // spheres do not have): whichever thread is done first shares the other's
+        // parallel parts.
         let (base, (lights, eye_grid)) = rayon::join(
             || Spheres::of_geometry(Arc::clone(&geometry)),
             || {
