@@ -161,6 +161,79 @@ mod tests {
         assert!(passed > 10_000 && failed > 10_000, "{passed} {failed}");
     }
 
+    /// The lanes' quick test agrees with [`may_cross`] at the edge of its sphere too:
+    /// rays bisected, one `f32` direction at a time, to the last that passes the line
+    /// test (the line's squared distance from the centre within a few roundings of
+    /// the widened radius's square), with its neighbour that fails beside it in the
+    /// bundle; and bounds bisected to the least that the ray through the centre
+    /// passes with, beside the one below.
+    #[test]
+    fn the_lanes_quick_test_is_may_cross_at_the_sphere_s_edge() {
+        let mut rng = rand_mt::Mt64::new(11);
+        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut edges = 0;
+        for case in 0..2_000 {
+            let origin = DVec3::new(unit(), unit(), unit()) * 20.0 - 10.0;
+            let aim = (DVec3::new(unit(), unit(), unit()) * 2.0 - 1.0).normalize();
+            let side = aim.any_orthonormal_vector();
+            let r = 10f64.powf(unit() * 2.0 - 1.0);
+            let c = origin + aim * r * (1.5 + 2.0 * unit());
+            let w = crate::accel::quick_radius(c, r);
+            let ray = |s: f64| {
+                Ray::new(&Query {
+                    origin,
+                    dir: (aim + side * s).normalize().as_vec3().normalize(),
+                    from: None,
+                })
+            };
+            let passes = |s: f64| may_cross(c, w, &ray(s), f32::INFINITY);
+            // From the centre's line (passing) to well outside the sphere (failing).
+            let (mut inside, mut outside) = (0.0, 2.0);
+            assert!(passes(inside) && !passes(outside), "case {case}");
+            for _ in 0..80 {
+                let mid = 0.5 * (inside + outside);
+                if passes(mid) {
+                    inside = mid;
+                } else {
+                    outside = mid;
+                }
+            }
+            let rays: [Ray; BUNDLE] =
+                std::array::from_fn(|i| ray(if i % 2 == 0 { inside } else { outside }));
+            let lanes = Lanes::new(&rays, BUNDLE);
+            let got = lanes.may_cross(origin, c, w, &[f32::INFINITY; BUNDLE]);
+            for (i, ray) in rays.iter().enumerate() {
+                let want = may_cross(c, w, ray, f32::INFINITY);
+                assert_eq!(got >> i & 1 == 1, want, "case {case}, lane {i}");
+            }
+            edges += usize::from(rays[0].d32 != rays[1].d32);
+            // And at the bound: the least `f32` bound the ray through the centre
+            // passes with (bisected on the bits, monotone for positive floats),
+            // beside the one below it.
+            let centre_ray = ray(0.0);
+            let reaches = |bits: u32| may_cross(c, w, &centre_ray, f32::from_bits(bits));
+            let (mut short, mut long) = (0.0f32.to_bits(), 1e4f32.to_bits());
+            assert!(!reaches(short) && reaches(long), "case {case}");
+            while long - short > 1 {
+                let mid = short + (long - short) / 2;
+                if reaches(mid) {
+                    long = mid;
+                } else {
+                    short = mid;
+                }
+            }
+            let t_max: [f32; BUNDLE] =
+                std::array::from_fn(|i| f32::from_bits(if i % 2 == 0 { long } else { short }));
+            let lanes = Lanes::new(&[centre_ray; BUNDLE], BUNDLE);
+            assert_eq!(
+                lanes.may_cross(origin, c, w, &t_max),
+                0b0101_0101,
+                "case {case}: the bound's edge"
+            );
+        }
+        assert!(edges > 1_900, "{edges} edges between two directions");
+    }
+
     /// The bundle's bound is the largest of its rays' bounds, lanes past the last
     /// left out.
     #[test]
