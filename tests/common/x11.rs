@@ -162,18 +162,29 @@ impl XServer {
         self.xdotool(&["getwindowname", window])
     }
 
-    /// Waits until the window's title satisfies `ok`; returns it.
+    /// Waits until the window's title satisfies `ok`; returns it. A timeout says the
+    /// last title seen and the viewer's stderr: where the viewer stopped.
     pub fn wait_title(
         &self,
         viewer: &mut Viewer,
         window: &str,
         ok: impl Fn(&str) -> bool,
     ) -> String {
-        wait_for("the window title", || {
+        let start = Instant::now();
+        loop {
             viewer.assert_running();
-            let t = self.title(window);
-            ok(&t).then_some(t)
-        })
+            let title = self.title(window);
+            if ok(&title) {
+                return title;
+            }
+            assert!(
+                start.elapsed() < TIMEOUT,
+                "timed out waiting for the window title; the last: {title:?}; the viewer's \
+                 stderr:\n{}",
+                viewer.stderr()
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
     }
 
     /// A screenshot of the window.
