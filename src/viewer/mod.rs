@@ -612,7 +612,13 @@ impl ApplicationHandler<Wake> for App {
                     window.request_redraw();
                 }
             }
-            WindowEvent::KeyboardInput { event, .. } => self.key(event_loop, &event),
+            // A synthetic press is a key already down as the window gains focus: not
+            // pressed for this window, so it does nothing.
+            WindowEvent::KeyboardInput {
+                event,
+                is_synthetic: false,
+                ..
+            } => self.key(event_loop, &event),
             WindowEvent::CursorMoved { position, .. } => {
                 let now = (position.x, position.y);
                 self.cursor = Some(now);
