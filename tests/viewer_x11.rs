@@ -196,6 +196,28 @@ fn done_frame(title: &str) -> Option<u32> {
     title.ends_with("- done").then_some(k)
 }
 
+/// Writes `small.toml` into `dir`: hw3 at 320×180 turning a quarter round in 4 frames
+/// at 2 frames a second (time enough for screenshots); returns its path.
+fn quarter_turn_scene(dir: &Path) -> PathBuf {
+    let mut scene = whitted::scene::hw3_scene(whitted::scene::HW3_DEFAULT_SEED);
+    scene.image.width = Some(320);
+    scene.image.height = Some(180);
+    scene.camera = Some(whitted::CameraSpec::LookAt {
+        look_from: glam::DVec3::new(0.0, 1.0, 1.0),
+        look_at: glam::DVec3::new(0.0, 0.0, -2.0),
+        up: glam::DVec3::Y,
+        vfov: 50.0,
+    });
+    scene.animation = Some(whitted::scene::Animation {
+        frames: 4,
+        fps: 2.0,
+        motion: whitted::scene::Motion::Orbit { degrees: 90.0 },
+    });
+    let path = dir.join("small.toml");
+    fs::write(&path, whitted::scene::to_toml(&scene)).unwrap();
+    path
+}
+
 /// A key held down as the window gains focus is not a press: winit reports it as a
 /// synthetic one, which the viewer leaves alone. (The animation test's first `.` came
 /// right after its `windowfocus`, and on a loaded machine the viewer read the focus
@@ -210,16 +232,7 @@ fn a_key_held_as_the_window_gains_focus_is_no_press() {
     let x = XServer::start();
     let dir = tempfile::tempdir().unwrap();
     let dir = dir.path();
-    let mut scene = whitted::scene::hw3_scene(whitted::scene::HW3_DEFAULT_SEED);
-    scene.image.width = Some(160);
-    scene.image.height = Some(90);
-    scene.animation = Some(whitted::scene::Animation {
-        frames: 4,
-        fps: 2.0,
-        motion: whitted::scene::Motion::Orbit { degrees: 90.0 },
-    });
-    let path = dir.join("small.toml");
-    fs::write(&path, whitted::scene::to_toml(&scene)).unwrap();
+    let path = quarter_turn_scene(dir);
     let (mut viewer, window) = start_viewer(&x, dir, &path, "softbuffer");
     x.wait_title(&mut viewer, &window, |t| done_frame(t) == Some(0));
     let root = x.xdotool(&["search", "--maxdepth", "0", "--name", ".*"]);
@@ -242,23 +255,7 @@ fn an_animated_scene_plays_and_steps_through_its_frames() {
     let x = XServer::start();
     let dir = tempfile::tempdir().unwrap();
     let dir = dir.path();
-    // A 4-frame quarter turn at 2 frames a second (time enough for screenshots).
-    let mut scene = whitted::scene::hw3_scene(whitted::scene::HW3_DEFAULT_SEED);
-    scene.image.width = Some(320);
-    scene.image.height = Some(180);
-    scene.camera = Some(whitted::CameraSpec::LookAt {
-        look_from: glam::DVec3::new(0.0, 1.0, 1.0),
-        look_at: glam::DVec3::new(0.0, 0.0, -2.0),
-        up: glam::DVec3::Y,
-        vfov: 50.0,
-    });
-    scene.animation = Some(whitted::scene::Animation {
-        frames: 4,
-        fps: 2.0,
-        motion: whitted::scene::Motion::Orbit { degrees: 90.0 },
-    });
-    let path = dir.join("small.toml");
-    fs::write(&path, whitted::scene::to_toml(&scene)).unwrap();
+    let path = quarter_turn_scene(dir);
     let out = Command::new(BIN)
         .args(["render", "small.toml", "-q", "-o", "f-%d.png"])
         .current_dir(dir)
