@@ -121,8 +121,7 @@ mod tests {
     /// rays, bounds from none to within the sphere; lanes past the last ray never pass.
     #[test]
     fn the_lanes_quick_test_is_may_cross_ray_by_ray() {
-        let mut rng = rand_mt::Mt64::new(5);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut unit = crate::accel::tests::uniform(5);
         let (mut passed, mut failed) = (0u32, 0u32);
         for case in 0..20_000 {
             let origin = DVec3::new(unit(), unit(), unit()) * 200.0 - 100.0;
@@ -169,8 +168,7 @@ mod tests {
     /// passes with, beside the one below.
     #[test]
     fn the_lanes_quick_test_is_may_cross_at_the_sphere_s_edge() {
-        let mut rng = rand_mt::Mt64::new(11);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut unit = crate::accel::tests::uniform(11);
         let mut edges = 0;
         for case in 0..2_000 {
             let origin = DVec3::new(unit(), unit(), unit()) * 20.0 - 10.0;

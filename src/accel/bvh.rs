@@ -887,12 +887,6 @@ mod tests {
         }
     }
 
-    /// Uniform numbers in [0, 1) from a Mersenne twister seeded with `seed`.
-    fn uniform(seed: u64) -> impl FnMut() -> f64 {
-        let mut rng = rand_mt::Mt64::new(seed);
-        move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
     /// `count` boxes with centres uniform in [0, 60)³ and half sides uniform up to
     /// `half`.
     fn random_boxes(unit: &mut impl FnMut() -> f64, count: usize, half: f32) -> Vec<Aabb> {
@@ -1287,7 +1281,7 @@ mod tests {
     }
 
     fn the_walk_meets_the_leaves_the_ray_meets_and_no_others_with(build: Builder) {
-        let mut unit = uniform(9);
+        let mut unit = crate::accel::tests::uniform(9);
         let boxes = random_boxes(&mut unit, 3000, 3.0);
         let (bvh, items) = build(boxes.len(), &|k| boxes[k]);
         let leaves = leaves_of(&bvh, &items, &boxes);
@@ -1358,7 +1352,7 @@ mod tests {
     }
 
     fn the_bundle_walk_visits_every_item_its_rays_visit_with(build: Builder) {
-        let mut unit = uniform(17);
+        let mut unit = crate::accel::tests::uniform(17);
         let boxes = random_boxes(&mut unit, 3000, 1.5);
         let (bvh, _) = build(boxes.len(), &|k| boxes[k]);
         let (mut own, mut own_near, mut visited_near) = (0usize, 0usize, 0usize);

@@ -843,8 +843,7 @@ mod tests {
     /// spheres around the centre are `always`, and only they.
     #[test]
     fn cells_list_the_spheres_seen_in_them_and_no_others() {
-        let mut rng = rand_mt::Mt64::new(11);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut unit = crate::accel::tests::uniform(11);
         let mut direction = || {
             let (z, phi) = (2.0 * unit() - 1.0, std::f64::consts::TAU * unit());
             let s = (1.0 - z * z).sqrt();
@@ -994,8 +993,7 @@ mod tests {
     /// 0.01 to 100, half-extents per axis from 10⁻⁵ to 2 times the distance (some hold
     /// the centre), as `(lo, hi)` relative to the centre.
     fn random_boxes(seed: u64, count: usize) -> Vec<(DVec3, DVec3)> {
-        let mut rng = rand_mt::Mt64::new(seed);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut unit = crate::accel::tests::uniform(seed);
         (0..count)
             .map(|_| {
                 let (z, phi) = (2.0 * unit() - 1.0, std::f64::consts::TAU * unit());
@@ -1018,8 +1016,7 @@ mod tests {
     #[test]
     fn silhouette_rect_holds_the_sphere_s_directions_and_no_more() {
         let n = 64u32;
-        let mut rng = rand_mt::Mt64::new(12);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut unit = crate::accel::tests::uniform(12);
         let (mut sphere_points, mut near_the_plane) = (0, 0);
         for _ in 0..3_000 {
             let face = (unit() * 6.0) as u32;
@@ -1150,8 +1147,7 @@ mod tests {
     #[test]
     fn face_rect_covers_the_cells_a_box_is_seen_in_and_no_face_it_is_not() {
         let n = 8u32;
-        let mut rng = rand_mt::Mt64::new(6);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut unit = crate::accel::tests::uniform(6);
         let (mut covered, mut behind, mut beyond) = (0, 0, 0);
         for (lo, hi) in random_boxes(7, 20_000) {
             let corners = corners(lo, hi);
@@ -1302,8 +1298,7 @@ mod tests {
     /// over several runs of the build, from small to ones seen over many cells).
     #[test]
     fn a_grid_is_built_within_a_bound_of_its_entries_and_not_below() {
-        let mut rng = rand_mt::Mt64::new(5);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut unit = crate::accel::tests::uniform(5);
         let spheres: Vec<(DVec3, f64)> = (0..3 * SPHERES_PER_RUN + 17)
             .map(|_| {
                 let c = DVec3::new(unit(), unit(), unit()) * 20.0 - DVec3::splat(10.0);
@@ -1441,8 +1436,7 @@ mod tests {
     /// every resolution of the ladder.
     #[test]
     fn fewest_entries_is_at_most_the_entries_listed() {
-        let mut rng = rand_mt::Mt64::new(23);
-        let mut unit = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut unit = crate::accel::tests::uniform(23);
         let centre = DVec3::new(0.25, -0.5, 0.75);
         for trial in 0..12 {
             let spheres: Vec<(DVec3, f64)> = (0..40 + 30 * trial)

@@ -83,6 +83,13 @@ fn roots64(o: DVec3, d: DVec3, c: DVec3, r: f64) -> Option<(f64, f64)> {
     }
 }
 
+/// Uniform numbers in [0, 1) from a Mersenne twister seeded with `seed`: the unit
+/// tests' reproducible random cases.
+pub(super) fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut rng = rand_mt::Mt64::new(seed);
+    move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+}
+
 /// Log-uniform `10^U(lo, hi)`.
 pub(super) fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
     (lo..hi).prop_map(|e: f64| 10f64.powf(e))
