@@ -15,7 +15,9 @@
 #
 # Then the viewer's line: a whole frame of hw3 at 1280×720 on two threads while the
 # camera orbits (`whitted time --orbit $ORBIT --no-preview`, the median frame) against
-# the Embree peer's hw3 render on two threads (median of RUNS), and their ratio.
+# the Embree peer's hw3 render on two threads (median of RUNS), and their ratio; and
+# like for like, the same frames against the peer's render of the same views (each
+# view written by `whitted time --views-to`, rendered once by the peer; the median).
 #
 # Environment: OUT (run.sh's output folder, default /tmp/peers-out), MANY (default
 # "1000 10000 100000 1000000"), RUNS (default 5), THREADS (default "1 2"), ORBIT
@@ -79,11 +81,19 @@ for scene in hw3 $(for n in $MANY; do echo "many_$n"; done); do
 done
 ORBIT=${ORBIT:-40}
 if [ "$ORBIT" -gt 0 ]; then
-    frame=$("$WHITTED" time --orbit "$ORBIT" --no-preview --threads 2 | field frame_ms)
+    mkdir -p "$tmp/views"
+    frame=$("$WHITTED" time --orbit "$ORBIT" --no-preview --threads 2 --views-to "$tmp/views" |
+        field frame_ms)
     : >"$tmp/erender"
     for _ in $(seq "$RUNS"); do
         NO_BENCH=1 "$EMBREE" "$SCN/hw3.txt" "$tmp/e.ppm" 2 | grep '^RESULT' | field render_s >>"$tmp/erender"
     done
     e=$(median <"$tmp/erender")
     echo "viewer: hw3 orbit ($ORBIT views, 2 threads) $frame ms a frame; Embree's hw3 render $e s; ÷ $(awk -v f="$frame" -v e="$e" 'BEGIN { printf "%.2f", f / 1000 / e }')"
+    : >"$tmp/eviews"
+    for view in "$tmp"/views/view_*.txt; do
+        NO_BENCH=1 "$EMBREE" "$view" "$tmp/e.ppm" 2 | grep '^RESULT' | field render_s >>"$tmp/eviews"
+    done
+    ev=$(median <"$tmp/eviews")
+    echo "viewer, like for like: Embree's render of the same $ORBIT views $ev s (median); ÷ $(awk -v f="$frame" -v e="$ev" 'BEGIN { printf "%.2f", f / 1000 / e }')"
 fi

@@ -63,6 +63,11 @@ enum Command {
         /// whole frames).
         #[arg(long, requires = "orbit")]
         no_preview: bool,
+        /// With --orbit: also write each timed view as a scene file of the peer
+        /// programs' format into this folder (view_01.txt, …), to time them on the same
+        /// views.
+        #[arg(long, value_name = "DIR", requires = "orbit")]
+        views_to: Option<PathBuf>,
     },
     /// Measure run time against error over a grid of quality settings on several
     /// scenes; writes bench.csv, bench.md and bench.svg (docs/quality.md).
@@ -123,7 +128,13 @@ fn main() -> ExitCode {
             threads,
             orbit,
             no_preview,
-        }) => cli::time_command(scene.as_deref(), runs, threads, orbit, !no_preview),
+            views_to,
+        }) => cli::time_command(
+            scene.as_deref(),
+            runs,
+            threads,
+            orbit.map(|views| (views, !no_preview, views_to)),
+        ),
         Some(Command::Scene { name: _, seed }) => cli::scene_command(seed),
     };
     match result {

@@ -144,16 +144,20 @@ impl OrbitTiming {
 /// the viewer's window does — its worker's passes, tracer cache and buffers, its
 /// choice of preview from the speed measured so far — without a window: the render
 /// time per frame of the viewer, apart from the blit. Without `preview`, every view is
-/// one full pass (the window's choice when a frame fits 1/30 s).
+/// one full pass (the window's choice when a frame fits 1/30 s). With `views_to`, each
+/// timed view is also written there as a scene of the peers' format ([`peer_scene`]),
+/// `view_01.txt` on.
 pub fn time_orbit(
     scene: &Scene,
     size: (u32, u32),
     views: usize,
     preview: bool,
+    views_to: Option<&std::path::Path>,
 ) -> anyhow::Result<OrbitTiming> {
     use crate::viewer::controls::{Action, CameraControl};
     use crate::viewer::schedule::{measured_speed, preview_factor};
     use crate::viewer::worker::{self, Buffers, Job, Report, TracerCache};
+    use anyhow::Context as _;
     use std::sync::Arc;
     use std::time::Instant;
 
@@ -206,6 +210,12 @@ pub fn time_orbit(
             start = Instant::now(); // the warm-up view: thread pool, caches
             continue;
         }
+        if let Some(dir) = views_to {
+            let path = dir.join(format!("view_{view:02}.txt"));
+            let text = peer_scene(&job.scene, size)?;
+            std::fs::write(&path, text)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
         timing.previews += usize::from(shown.iter().any(|s| s.preview));
         if let Some(full) = shown.iter().find(|s| !s.preview) {
             timing.frame_seconds.push(full.pass_seconds);
@@ -214,6 +224,47 @@ pub fn time_orbit(
     }
     timing.wall_seconds = start.elapsed().as_secs_f64();
     Ok(timing)
+}
+
+/// `scene` at `size` in the peer programs' scene format (`../shared/peers/make_hw3.py`):
+/// its camera's frame, one light, the image's size and depth, and a line a sphere. The
+/// peers know no other sky and one light only; a scene they cannot render is an error.
+pub fn peer_scene(scene: &Scene, size: (u32, u32)) -> anyhow::Result<String> {
+    use std::fmt::Write;
+    let [light] = scene.lights.as_slice() else {
+        anyhow::bail!("the peers render one light, not {}", scene.lights.len());
+    };
+    anyhow::ensure!(
+        scene.sky == crate::scene::Sky::default(),
+        "the peers render the default sky only"
+    );
+    let c = scene.camera(size.0, size.1)?;
+    let v = |v: glam::DVec3| format!("{} {} {}", v.x, v.y, v.z);
+    let mut text = format!(
+        "camera {}  {}  {}  {}\nlight {}  {}\nsize {} {}\ndepth {}\n",
+        v(c.origin),
+        v(c.lower_left),
+        v(c.horizontal),
+        v(c.vertical),
+        v(light.position),
+        v(light.intensity),
+        size.0,
+        size.1,
+        scene.settings().quality.max_depth,
+    );
+    for s in &scene.spheres {
+        let line = format!(
+            "sphere {}  {}  {}  {} {}  {}",
+            v(s.center),
+            s.radius,
+            v(s.color),
+            s.reflect,
+            s.transmit,
+            s.ior
+        );
+        writeln!(text, "{line}")?;
+    }
+    Ok(text)
 }
 
 /// The walk of incoherent rays through the hierarchy alone, for `cargo bench`: the

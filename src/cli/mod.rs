@@ -6,7 +6,7 @@ pub(crate) mod compare;
 pub(crate) mod render;
 pub(crate) mod stitch;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
@@ -165,19 +165,19 @@ pub(crate) fn time_command(
     path: Option<&Path>,
     runs: usize,
     threads: Option<u32>,
-    orbit: Option<u32>,
-    preview: bool,
+    orbit: Option<(u32, bool, Option<PathBuf>)>,
 ) -> anyhow::Result<()> {
     let scene = load_scene(path)?;
     let name = path.map_or("hw3".to_string(), |p| p.display().to_string());
-    if let Some(views) = orbit {
+    if let Some((views, preview, views_to)) = orbit {
         let size = (scene.settings().width, scene.settings().height);
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.map_or(0, |t| t as usize))
             .build()
             .context("cannot start the threads")?;
-        let timing =
-            pool.install(|| whitted::speed::time_orbit(&scene, size, views as usize, preview))?;
+        let timing = pool.install(|| {
+            whitted::speed::time_orbit(&scene, size, views as usize, preview, views_to.as_deref())
+        })?;
         let line = timing.result_line(&name, pool.current_num_threads(), size);
         println!("{line}");
         return Ok(());
