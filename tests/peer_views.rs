@@ -109,35 +109,63 @@ fn the_orbit_s_views_are_the_peers_scene_seen_from_the_orbit() {
     }
 }
 
-/// A scene the peers cannot render (two lights) is a one-line error and a failure,
-/// and so is a folder that cannot be written; `--views-to` needs `--orbit`.
+/// A scene the peers cannot render (two lights, or a sky of its own) is a one-line
+/// error and a failure, and writes no view; so is a folder that cannot be written;
+/// `--views-to` needs `--orbit`. The same scene with one light and the default sky
+/// gives its view, line for line.
 #[test]
 fn views_the_peers_cannot_take_are_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("two.toml");
-    std::fs::write(
-        &scene,
-        "[[light]]\nposition = [0, 5, 0]\nintensity = [1, 1, 1]\n\n\
-         [[light]]\nposition = [5, 5, 0]\nintensity = [1, 1, 1]\n\n\
-         [[sphere]]\ncenter = [0, 0, -3]\nradius = 1\ncolor = [1, 1, 1]\n\n\
-         [image]\nwidth = 16\nheight = 9\n",
-    )
-    .unwrap();
     let views = dir.path().to_str().unwrap();
-    let scene = scene.to_str().unwrap();
-    let out = run(&[
-        "time",
-        scene,
-        "--orbit",
-        "1",
-        "--no-preview",
-        "--views-to",
-        views,
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("the peers render one light, not 2"), "{err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    let light = |x: u32| format!("[[light]]\nposition = [{x}, 5, 0]\nintensity = [1, 1, 1]\n\n");
+    let ball = "[[sphere]]\ncenter = [0, 0, -3]\nradius = 1\ncolor = [1, 1, 1]\n\n\
+                [image]\nwidth = 16\nheight = 9\n";
+    let sky = "[sky]\ndown = [0.2, 0.4, 0.6]\nup = [1, 0, 0.5]\n\n";
+    for (name, text, error) in [
+        (
+            "two.toml",
+            format!("{}{}{ball}", light(0), light(5)),
+            Some("the peers render one light, not 2"),
+        ),
+        (
+            "sky.toml",
+            format!("{}{sky}{ball}", light(0)),
+            Some("the peers render the default sky only"),
+        ),
+        ("fine.toml", format!("{}{ball}", light(0)), None),
+    ] {
+        let scene = dir.path().join(name);
+        std::fs::write(&scene, text).unwrap();
+        let scene = scene.to_str().unwrap();
+        let out = run(&[
+            "time",
+            scene,
+            "--orbit",
+            "1",
+            "--no-preview",
+            "--views-to",
+            views,
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        let view = dir.path().join("view_01.txt");
+        let Some(error) = error else {
+            assert!(out.status.success(), "{name}: {err}");
+            let text = std::fs::read_to_string(view).unwrap();
+            let lines: Vec<&str> = text.lines().skip(1).collect();
+            let expected = [
+                "light 0 5 0  1 1 1",
+                "size 16 9",
+                "depth 5",
+                "sphere 0 0 -3  1  1 1 1  0 0  2",
+            ];
+            assert_eq!(lines, expected, "{name}");
+            continue;
+        };
+        assert_eq!(out.status.code(), Some(1), "{name}: {err}");
+        assert!(err.contains(error), "{name}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
+        assert!(!view.exists(), "{name}");
+    }
 
     let missing = dir.path().join("no").join("such");
     let out = run(&[
