@@ -12,7 +12,7 @@ use common::{entries, run, skip, whitted};
 /// The peers' own generator's hw3 scene (`../shared/peers/make_hw3.py`), its lines
 /// but the comment; `None` where the generator or Python is missing.
 fn peers_hw3(dir: &Path) -> Option<Vec<String>> {
-    let script = Path::new("../shared/peers/make_hw3.py");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/peers/make_hw3.py");
     let made = Command::new("python3")
         .arg(script)
         .arg("--outdir")
