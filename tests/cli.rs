@@ -492,6 +492,26 @@ fn field<'a>(line: &'a str, key: &str) -> &'a str {
         .unwrap_or_else(|| panic!("no {key} in {line}"))
 }
 
+/// An orbit whose frames no machine renders within 1/30 s (hw3 at 4096×4096, two
+/// threads: 16.8 million pixels) shows a preview before every timed view, and counts
+/// each (`previews`).
+#[test]
+fn an_orbit_too_slow_for_thirty_frames_a_second_shows_previews() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("big.toml");
+    let text = whitted::scene::hw3_toml(whitted::scene::HW3_DEFAULT_SEED)
+        .replace("width = 1280", "width = 4096")
+        .replace("height = 720", "height = 4096");
+    std::fs::write(&scene, text).unwrap();
+    let scene = scene.to_str().unwrap();
+    let out = whitted(&["time", scene, "--orbit", "2", "--threads", "2"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(field(&line, "size"), "4096x4096", "{line}");
+    assert_eq!(field(&line, "views"), "2", "{line}");
+    assert_eq!(field(&line, "previews"), "2", "{line}");
+}
+
 #[test]
 fn time_prints_one_result_line_for_renders_and_for_orbits() {
     let dir = tempfile::tempdir().unwrap();
