@@ -213,8 +213,8 @@ pub fn time_orbit(
         if let Some(dir) = views_to {
             let path = dir.join(format!("view_{view:02}.txt"));
             let text = peer_scene(&job.scene, size)?;
-            std::fs::write(&path, text)
-                .with_context(|| format!("cannot write {}", path.display()))?;
+            crate::image_io::write_atomically(&path, text.as_bytes())
+                .context("cannot write a view")?;
         }
         timing.previews += usize::from(shown.iter().any(|s| s.preview));
         if let Some(full) = shown.iter().find(|s| !s.preview) {
@@ -253,7 +253,8 @@ pub fn peer_scene(scene: &Scene, size: (u32, u32)) -> anyhow::Result<String> {
         scene.settings().quality.max_depth,
     );
     for s in &scene.spheres {
-        let line = format!(
+        writeln!(
+            text,
             "sphere {}  {}  {}  {} {}  {}",
             v(s.center),
             s.radius,
@@ -261,8 +262,7 @@ pub fn peer_scene(scene: &Scene, size: (u32, u32)) -> anyhow::Result<String> {
             s.reflect,
             s.transmit,
             s.ior
-        );
-        writeln!(text, "{line}")?;
+        )?;
     }
     Ok(text)
 }
