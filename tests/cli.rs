@@ -492,17 +492,23 @@ fn field<'a>(line: &'a str, key: &str) -> &'a str {
         .unwrap_or_else(|| panic!("no {key} in {line}"))
 }
 
+/// The built-in hw3 scene as a file in `dir`, at `width`×`height`.
+fn hw3_file(dir: &Path, width: u32, height: u32) -> std::path::PathBuf {
+    let scene = dir.join(format!("hw3_{width}x{height}.toml"));
+    let text = whitted::scene::hw3_toml(whitted::scene::HW3_DEFAULT_SEED)
+        .replace("width = 1280", &format!("width = {width}"))
+        .replace("height = 720", &format!("height = {height}"));
+    std::fs::write(&scene, text).unwrap();
+    scene
+}
+
 /// An orbit whose frames no machine renders within 1/30 s (hw3 at 4096×4096, two
 /// threads: 16.8 million pixels) shows a preview before every timed view, and counts
 /// each (`previews`).
 #[test]
 fn an_orbit_too_slow_for_thirty_frames_a_second_shows_previews() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("big.toml");
-    let text = whitted::scene::hw3_toml(whitted::scene::HW3_DEFAULT_SEED)
-        .replace("width = 1280", "width = 4096")
-        .replace("height = 720", "height = 4096");
-    std::fs::write(&scene, text).unwrap();
+    let scene = hw3_file(dir.path(), 4096, 4096);
     let scene = scene.to_str().unwrap();
     let out = whitted(&["time", scene, "--orbit", "2", "--threads", "2"]);
     assert!(out.status.success(), "{}", stderr(&out));
@@ -515,12 +521,7 @@ fn an_orbit_too_slow_for_thirty_frames_a_second_shows_previews() {
 #[test]
 fn time_prints_one_result_line_for_renders_and_for_orbits() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("small.toml");
-    let mut text = whitted::scene::hw3_toml(whitted::scene::HW3_DEFAULT_SEED);
-    text = text
-        .replace("width = 1280", "width = 64")
-        .replace("height = 720", "height = 36");
-    std::fs::write(&scene, text).unwrap();
+    let scene = hw3_file(dir.path(), 64, 36);
     let scene = scene.to_str().unwrap();
 
     let out = whitted(&["time", scene, "--runs", "2", "--threads", "1"]);
