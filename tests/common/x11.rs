@@ -39,13 +39,18 @@ pub fn x_tools_or_skip(test: &str) -> bool {
 
 /// Polls `f` until it gives a value or `TIMEOUT` passes.
 pub fn wait_for<T>(what: &str, mut f: impl FnMut() -> Option<T>) -> T {
+    poll(|| f().ok_or(())).unwrap_or_else(|()| panic!("timed out waiting for {what}"))
+}
+
+/// Polls `f` every 50 ms until it gives `Ok` or `TIMEOUT` passes; then the last `Err`.
+fn poll<T, E>(mut f: impl FnMut() -> Result<T, E>) -> Result<T, E> {
     let start = Instant::now();
     loop {
-        if let Some(v) = f() {
-            return v;
+        match f() {
+            Ok(v) => return Ok(v),
+            Err(last) if start.elapsed() >= TIMEOUT => return Err(last),
+            Err(_) => std::thread::sleep(Duration::from_millis(50)),
         }
-        assert!(start.elapsed() < TIMEOUT, "timed out waiting for {what}");
-        std::thread::sleep(Duration::from_millis(50));
     }
 }
 
@@ -170,21 +175,22 @@ impl XServer {
         window: &str,
         ok: impl Fn(&str) -> bool,
     ) -> String {
-        let start = Instant::now();
-        loop {
+        let title = poll(|| {
             viewer.assert_running();
             let title = self.title(window);
             if ok(&title) {
-                return title;
+                Ok(title)
+            } else {
+                Err(title)
             }
-            assert!(
-                start.elapsed() < TIMEOUT,
-                "timed out waiting for the window title; the last: {title:?}; the viewer's \
+        });
+        title.unwrap_or_else(|last| {
+            panic!(
+                "timed out waiting for the window title; the last: {last:?}; the viewer's \
                  stderr:\n{}",
                 viewer.stderr()
-            );
-            std::thread::sleep(Duration::from_millis(50));
-        }
+            )
+        })
     }
 
     /// A screenshot of the window.
