@@ -133,7 +133,11 @@ fn main() -> ExitCode {
             scene.as_deref(),
             runs,
             threads,
-            orbit.map(|views| (views, !no_preview, views_to)),
+            orbit.map(|views| cli::Orbit {
+                views,
+                preview: !no_preview,
+                views_to,
+            }),
         ),
         Some(Command::Scene { name: _, seed }) => cli::scene_command(seed),
     };

@@ -161,15 +161,28 @@ pub(crate) fn scene_command(seed: u64) -> anyhow::Result<()> {
     }
 }
 
+/// What `whitted time --orbit` times: `views` views, previews as the window chooses
+/// them or none, each view's scene written into `views_to` if given.
+pub(crate) struct Orbit {
+    pub(crate) views: u32,
+    pub(crate) preview: bool,
+    pub(crate) views_to: Option<PathBuf>,
+}
+
 pub(crate) fn time_command(
     path: Option<&Path>,
     runs: usize,
     threads: Option<u32>,
-    orbit: Option<(u32, bool, Option<PathBuf>)>,
+    orbit: Option<Orbit>,
 ) -> anyhow::Result<()> {
     let scene = load_scene(path)?;
     let name = path.map_or("hw3".to_string(), |p| p.display().to_string());
-    if let Some((views, preview, views_to)) = orbit {
+    if let Some(Orbit {
+        views,
+        preview,
+        views_to,
+    }) = orbit
+    {
         let size = (scene.settings().width, scene.settings().height);
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.map_or(0, |t| t as usize))
