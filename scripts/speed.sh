@@ -9,8 +9,10 @@
 #   QUICK=1 ../shared/peers/run.sh      # builds the peers (needs libembree-dev)
 #   scripts/speed.sh                    # the table below, for hw3 and many_N
 #
-# Columns: Embree and whitted cold (median s), whitted ÷ Embree, whitted's warm
-# render and build (median s, `whitted time`), Embree's build (median s), and the
+# Columns: Embree and whitted cold (median s), whitted ÷ Embree; the builds in those
+# same cold runs (whitted: the build the closing line gives; the peer: build_s; median
+# s) and their ratio; whitted's warm render and build (median s, `whitted time`: its
+# builds run after renders in one process, each into freshly mapped memory); and the
 # peak resident memory of `whitted render` (MB, the largest of the runs).
 #
 # Then the viewer's line: a whole frame of hw3 at 1280×720 on two threads while the
@@ -53,12 +55,13 @@ median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
 
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'), $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC'); runs $RUNS"
-printf '| %-12s | %-7s | %-11s | %-12s | %-9s | %-11s | %-12s | %-12s | %-10s |\n' \
-    scene threads "Embree cold" "whitted cold" "whitted ÷" "whitted warm" "whitted build" "Embree build" "peak MB"
-printf '|%s|\n' "--------------|---------|-------------|--------------|-----------|-------------|--------------|--------------|------------"
+printf '| %-12s | %-7s | %-11s | %-12s | %-9s | %-13s | %-12s | %-7s | %-11s | %-10s | %-10s |\n' \
+    scene threads "Embree cold" "whitted cold" "whitted ÷" "whitted build" "Embree build" "build ÷" \
+    "whitted warm" "warm build" "peak MB"
+printf '|%s|\n' "--------------|---------|-------------|--------------|-----------|---------------|--------------|---------|-------------|------------|------------"
 for scene in hw3 $(for n in $MANY; do echo "many_$n"; done); do
     for t in $THREADS; do
-        : >"$tmp/embree" ; : >"$tmp/ebuild" ; : >"$tmp/whitted" ; : >"$tmp/mem"
+        : >"$tmp/embree" ; : >"$tmp/ebuild" ; : >"$tmp/whitted" ; : >"$tmp/wbuild" ; : >"$tmp/mem"
         for _ in $(seq "$RUNS"); do
             line=$(NO_BENCH=1 "$EMBREE" "$SCN/$scene.txt" "$tmp/e.ppm" "$t" | grep '^RESULT')
             b=$(field build_s <<<"$line")
@@ -67,16 +70,20 @@ for scene in hw3 $(for n in $MANY; do echo "many_$n"; done); do
             echo "$b" >>"$tmp/ebuild"
             /usr/bin/time -f '%M' -o "$tmp/rss" "$WHITTED" render "$SCN/$scene.toml" -o "$tmp/w.ppm" \
                 --threads "$t" 2>"$tmp/err" >/dev/null
-            sed -n 's/^rendered .* in \([0-9.]*\) s:.*/\1/p' "$tmp/err" >>"$tmp/whitted"
+            sed -n 's/^rendered .* in \([0-9.]*\) s (build.*/\1/p' "$tmp/err" >>"$tmp/whitted"
+            sed -n 's/^rendered .* (build \([0-9.]*\) s):.*/\1/p' "$tmp/err" >>"$tmp/wbuild"
             echo $(( $(cat "$tmp/rss") / 1024 )) >>"$tmp/mem"
         done
         warm=$("$WHITTED" time "$SCN/$scene.toml" --runs "$RUNS" --threads "$t")
         e=$(median <"$tmp/embree")
         w=$(median <"$tmp/whitted")
-        printf '| %-12s | %-7s | %-11.4f | %-12.4f | %-9.2f | %-11s | %-12s | %-12s | %-10s |\n' \
+        eb=$(median <"$tmp/ebuild")
+        wb=$(median <"$tmp/wbuild")
+        printf '| %-12s | %-7s | %-11.4f | %-12.4f | %-9.2f | %-13.4f | %-12.4f | %-7.2f | %-11s | %-10s | %-10s |\n' \
             "$scene" "$t" "$e" "$w" "$(awk -v w="$w" -v e="$e" 'BEGIN { print w / e }')" \
+            "$wb" "$eb" "$(awk -v w="$wb" -v e="$eb" 'BEGIN { print w / e }')" \
             "$(field render_s <<<"$warm")" "$(field build_s <<<"$warm")" \
-            "$(median <"$tmp/ebuild")" "$(sort -g "$tmp/mem" | tail -1)"
+            "$(sort -g "$tmp/mem" | tail -1)"
     done
 done
 ORBIT=${ORBIT:-40}

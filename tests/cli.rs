@@ -441,13 +441,22 @@ fn a_good_render_exits_0_with_a_closing_line() {
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let err = stderr(&out);
     let last = err.lines().last().unwrap_or_default();
-    // e.g. "rendered hw3 32x18 (1 spp, depth 5) in 0.0011 s: 3541 rays, 1.3 Mrays/s"
+    // e.g. "rendered hw3 32x18 (1 spp, depth 5) in 0.0011 s (build 0.0002 s): 3541 rays,
+    // 1.3 Mrays/s"
     assert!(
         last.starts_with("rendered hw3 32x18")
             && last.contains(" rays, ")
             && last.ends_with("Mrays/s"),
         "closing line: {last}"
     );
+    // The build is part of the time the line gives, and both are figures.
+    let seconds = |before: &str, after: &str| -> f64 {
+        let from = last.find(before).expect(before) + before.len();
+        let to = from + last[from..].find(after).expect(after);
+        last[from..to].parse().expect("seconds")
+    };
+    let (total, build) = (seconds(" in ", " s (build"), seconds("(build ", " s)"));
+    assert!(0.0 < build && build <= total, "closing line: {last}");
     assert!(err.contains("wrote "), "{err}");
     assert_eq!(common::entries(dir.path()), ["out.png"]);
 

@@ -181,12 +181,13 @@ pub(crate) fn render_command(args: RenderArgs) -> anyhow::Result<()> {
     }
     if !args.quiet {
         eprintln!(
-            "rendered {} {}x{} ({}) in {:.4} s: {} rays, {:.1} Mrays/s",
+            "rendered {} {}x{} ({}) in {:.4} s (build {:.4} s): {} rays, {:.1} Mrays/s",
             scene.name,
             area.width,
             area.height,
             sampling(&opts.quality, stats.rays.primary, area),
             stats.seconds,
+            stats.build_seconds,
             stats.rays.total(),
             stats.mrays_per_second()
         );
