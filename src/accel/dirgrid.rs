@@ -49,6 +49,9 @@ pub(super) struct Listed<T> {
 /// Spheres a unit of parallel work of the build: enough to outweigh its overhead.
 const SPHERES_PER_RUN: usize = 2048;
 
+/// Spheres a bucket of the sort by distance on average: few enough for the caches.
+const SPHERES_PER_BUCKET: usize = 4096;
+
 /// A grid built with wide spheres apart lists a sphere seen at an angular radius
 /// whose sine is at least this (30°, a fifteenth of all directions) in its `wide`
 /// list instead of its cells. The ground of the peers' scenes, seen from their light
@@ -297,10 +300,7 @@ fn nearest_first<T: Copy + Send + Sync>(
     view: Option<&ViewPyramid>,
     data: impl Fn(DVec3, f64) -> T + Sync,
 ) -> Vec<((DVec3, f64), Listed<T>)> {
-    // A radix sort by the distance (in `total_cmp`'s order, stable, so ties stay in
-    // index order) reads no memory but the entries and decides no coin toss per
-    // comparison.
-    let mut entries: Vec<(u32, f32)> = spheres
+    let entries: Vec<(u32, f32)> = spheres
         .par_iter()
         .with_min_len(SPHERES_PER_RUN)
         .enumerate()
@@ -311,24 +311,61 @@ fn nearest_first<T: Copy + Send + Sync>(
             (k as u32, round_down(d))
         })
         .collect();
-    radsort::sort_by_key(&mut entries, |&(_, near)| near);
-    // The spheres gathered in that order: the build's walk over runs then reads
-    // memory in order, and the gather's loads, independent of each other, overlap (a
-    // million spheres are 32 MB, and a load in sorted order misses the caches).
-    entries
-        .par_iter()
-        .map(|&(k, near)| {
-            let (c, r) = spheres[k as usize];
-            (
-                (c, r),
-                Listed {
-                    k,
-                    near,
-                    data: data(c, r),
-                },
-            )
-        })
-        .collect()
+    let Some(&(first, near_first)) = entries.first() else {
+        return Vec::new();
+    };
+    let listed = |k: u32, near: f32| {
+        let (c, r) = spheres[k as usize];
+        let data = data(c, r);
+        ((c, r), Listed { k, near, data })
+    };
+    // The spheres go into buckets of ranges of the distance, read in index order and
+    // written each into its bucket's next place (a pass over memory in order, where a
+    // gather in sorted order missed the caches on every sphere); then each bucket, a
+    // few thousand spheres that the caches hold, is sorted on its own (a radix sort:
+    // in `total_cmp`'s order, stable, so ties stay in index order, and no coin toss
+    // per comparison). A bucket's number never decreases with the distance, so the
+    // buckets in order are sorted.
+    let (lo, hi) = entries.iter().fold(
+        (f32::INFINITY, f32::NEG_INFINITY),
+        |(lo, hi), &(_, near)| (lo.min(near), hi.max(near)),
+    );
+    let buckets = entries.len().div_ceil(SPHERES_PER_BUCKET);
+    let scale = buckets as f32 / (hi - lo);
+    let bucket = |near: f32| match scale.is_finite() {
+        true => (((near - lo) * scale) as usize).min(buckets - 1),
+        false => 0,
+    };
+    let mut ends = vec![0usize; buckets];
+    for &(_, near) in &entries {
+        ends[bucket(near)] += 1;
+    }
+    let mut end = 0;
+    for count in &mut ends {
+        end += *count;
+        *count = end;
+    }
+    // Filled with any entry on the pool's threads first: their page faults overlap.
+    let any = listed(first, near_first);
+    let mut sorted: Vec<_> = (0..entries.len()).into_par_iter().map(|_| any).collect();
+    // Last to first, each before its bucket's end, which leaves `ends` at the starts.
+    for &(k, near) in entries.iter().rev() {
+        let place = &mut ends[bucket(near)];
+        *place -= 1;
+        sorted[*place] = listed(k, near);
+    }
+    let mut rest = sorted.as_mut_slice();
+    let mut parts = Vec::with_capacity(buckets);
+    for pair in ends.windows(2) {
+        let (part, others) = rest.split_at_mut(pair[1] - pair[0]);
+        parts.push(part);
+        rest = others;
+    }
+    parts.push(rest);
+    parts
+        .into_par_iter()
+        .for_each(|part| radsort::sort_by_key(part, |(_, entry)| entry.near));
+    sorted
 }
 
 impl DirGrid {
@@ -829,8 +866,8 @@ mod tests {
 
     use super::{
         cell_places, cell_ranges, coarser, face_rect, fewest_entries, most_entries, nearest_first,
-        only_face, silhouette_rect, DirGrid, Listed, COARSEST, ENTRIES_ANY, ENTRIES_PER_SPHERE,
-        MOST_WIDE, SPHERES_PER_RUN, WIDEN,
+        only_face, silhouette_rect, DirGrid, Listed, ViewPyramid, COARSEST, ENTRIES_ANY,
+        ENTRIES_PER_SPHERE, MOST_WIDE, SPHERES_PER_BUCKET, SPHERES_PER_RUN, WIDEN,
     };
 
     /// What a grid lists, against the spheres' geometry in `f64` and directions drawn at
@@ -1232,6 +1269,62 @@ mod tests {
         want.extend((0..40).filter(|k| k % 4 < 2));
         want.extend((0..40).filter(|k| k % 4 == 2));
         assert_eq!(ks, want);
+    }
+
+    /// `nearest_first` orders the spheres as a stable sort by their rounded nearest
+    /// distance does, in `total_cmp`'s order: over many buckets, with ties, spheres
+    /// around the centre (distances below zero), one far away (most buckets then
+    /// empty) and spheres the view leaves out.
+    #[test]
+    fn nearest_first_is_a_stable_sort_by_the_nearest_distance() {
+        let mut unit = crate::accel::tests::uniform(41);
+        let centre = DVec3::new(-3.0, 1.0, 2.0);
+        for count in [1, 7, 3 * SPHERES_PER_BUCKET + 5, 20 * SPHERES_PER_BUCKET] {
+            let mut spheres: Vec<(DVec3, f64)> = (0..count)
+                .map(|k| {
+                    let dir = (DVec3::new(unit(), unit(), unit()) - 0.5).normalize_or(DVec3::Z);
+                    let (dist, r) = match k % 5 {
+                        0 => (2.0, 0.5),          // ties
+                        1 => (0.1, 0.4 * unit()), // around the centre, some
+                        _ => (1.0 + 50.0 * unit(), 0.01 + unit()),
+                    };
+                    (centre + dir * dist, r)
+                })
+                .collect();
+            if count > 1 {
+                spheres[count / 2] = (centre + DVec3::new(0.0, 1e7, 0.0), 1.0);
+            }
+            // A film a unit ahead along −z, 2 wide and 2 high: a quarter of the directions.
+            let film = DVec3::new(-1.0, -1.0, -1.0);
+            let view = ViewPyramid::new(centre, centre + film, 2.0 * DVec3::X, 2.0 * DVec3::Y)
+                .expect("a proper pyramid");
+            for view in [None, Some(&view)] {
+                let sorted = nearest_first(centre, &spheres, view, |c, r| (c, r));
+                let mut want: Vec<(u32, f32)> = spheres
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &(c, r))| view.is_none_or(|v| v.may_see(c - centre, r)))
+                    .map(|(k, &(c, r))| {
+                        let dist = (c - centre).length();
+                        let d = (dist - r) - 1e-6 * (dist + r + centre.abs().max_element());
+                        (k as u32, super::super::round_down(d))
+                    })
+                    .collect();
+                want.sort_by(|a, b| a.1.total_cmp(&b.1));
+                let got: Vec<(u32, f32)> = sorted.iter().map(|(_, e)| (e.k, e.near)).collect();
+                assert_eq!(got.len(), want.len(), "count {count}");
+                for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+                    assert!(
+                        g.0 == w.0 && g.1.to_bits() == w.1.to_bits(),
+                        "count {count}, place {i}: {g:?} against {w:?}"
+                    );
+                }
+                for ((c, r), e) in &sorted {
+                    assert_eq!((*c, *r), spheres[e.k as usize]);
+                    assert_eq!(e.data, spheres[e.k as usize]);
+                }
+            }
+        }
     }
 
     /// Built with wide spheres apart, a grid lists a sphere seen at an angular radius
