@@ -1273,25 +1273,35 @@ mod tests {
 
     /// `nearest_first` orders the spheres as a stable sort by their rounded nearest
     /// distance does, in `total_cmp`'s order: over many buckets, with ties, spheres
-    /// around the centre (distances below zero), one far away (most buckets then
-    /// empty) and spheres the view leaves out.
+    /// around the centre (distances below zero, all of them within a few buckets'
+    /// width of zero in one case), one far away (most buckets then empty) and spheres
+    /// the view leaves out.
     #[test]
     fn nearest_first_is_a_stable_sort_by_the_nearest_distance() {
         let mut unit = crate::accel::tests::uniform(41);
         let centre = DVec3::new(-3.0, 1.0, 2.0);
-        for count in [1, 7, 3 * SPHERES_PER_BUCKET + 5, 20 * SPHERES_PER_BUCKET] {
+        let many = 20 * SPHERES_PER_BUCKET;
+        let cases = [
+            (1, 50.0, false),
+            (7, 50.0, true),
+            (3 * SPHERES_PER_BUCKET + 5, 50.0, true),
+            (many, 50.0, false),
+            (many, 50.0, true),
+            (many, 1.0, false),
+        ];
+        for (count, spread, far_one) in cases {
             let mut spheres: Vec<(DVec3, f64)> = (0..count)
                 .map(|k| {
                     let dir = (DVec3::new(unit(), unit(), unit()) - 0.5).normalize_or(DVec3::Z);
                     let (dist, r) = match k % 5 {
-                        0 => (2.0, 0.5),          // ties
+                        0 => (0.5 * spread, 0.5), // ties
                         1 => (0.1, 0.4 * unit()), // around the centre, some
-                        _ => (1.0 + 50.0 * unit(), 0.01 + unit()),
+                        _ => (spread * unit(), 0.01 + unit()),
                     };
                     (centre + dir * dist, r)
                 })
                 .collect();
-            if count > 1 {
+            if far_one {
                 spheres[count / 2] = (centre + DVec3::new(0.0, 1e7, 0.0), 1.0);
             }
             // A film a unit ahead along −z, 2 wide and 2 high: a quarter of the directions.
