@@ -289,6 +289,18 @@ fn cell_ranges<'a, T>(
 /// the rounding of query directions many times over.
 const WIDEN: f64 = 1e-4;
 
+/// Counts of ranges laid end to end, each turned into its range's end; returns the
+/// last end, the total (a counting sort's first step: each item then goes just
+/// before its range's end, taken last to first, which keeps their order).
+fn running_ends<N: Copy + Default + std::ops::AddAssign>(counts: &mut [N]) -> N {
+    let mut end = N::default();
+    for count in counts {
+        end += *count;
+        *count = end;
+    }
+    end
+}
+
 /// The spheres of a grid around `centre` (those `view` may see), nearest first, each
 /// with its entry: its index, its nearest distance from the centre rounded down (so
 /// that the early exit of queries stays conservative) and `data` of it. Visited in
@@ -332,19 +344,18 @@ fn nearest_first<T: Copy + Send + Sync>(
     );
     let buckets = entries.len().div_ceil(SPHERES_PER_BUCKET);
     let scale = buckets as f32 / (hi - lo);
-    let bucket = |near: f32| match scale.is_finite() {
-        true => (((near - lo) * scale) as usize).min(buckets - 1),
-        false => 0,
+    let bucket = |near: f32| {
+        if scale.is_finite() {
+            (((near - lo) * scale) as usize).min(buckets - 1)
+        } else {
+            0
+        }
     };
     let mut ends = vec![0usize; buckets];
     for &(_, near) in &entries {
         ends[bucket(near)] += 1;
     }
-    let mut end = 0;
-    for count in &mut ends {
-        end += *count;
-        *count = end;
-    }
+    running_ends(&mut ends);
     // Filled with any entry on the pool's threads first: their page faults overlap.
     let any = listed(first, near_first);
     let mut sorted: Vec<_> = (0..entries.len()).into_par_iter().map(|_| any).collect();
@@ -509,11 +520,7 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         for &(cell, _) in runs.iter().flat_map(|run| &run.pairs) {
             offsets[cell as usize] += 1;
         }
-        let mut end = 0;
-        for offset in &mut offsets {
-            end += *offset;
-            *offset = end;
-        }
+        let end = running_ends(&mut offsets);
         // Filled with any entry first (every place is written below), on the pool's
         // threads: the fill is the first touch of fresh pages, whose faults then
         // overlap.
