@@ -633,7 +633,8 @@ struct CellCones {
     /// `⌈n/2⌉`: the cells of a quarter of the face per side.
     half_n: u32,
     /// Per (u, v) of the quarter `u, v < half_n`: unit axis in face coordinates
-    /// (u, v, 1)/|…| and cos, sin of the half-angle. The other quarters mirror it.
+    /// (u, v, 1)/|…| and the cosine (bounded from below) and sine (from above) of the
+    /// widened half-angle. The other quarters mirror it.
     quarter: Vec<(DVec3, f64, f64)>,
 }
 
@@ -671,13 +672,23 @@ impl CellCones {
                 DVec3::new(at(u + 1), at(v + 1), 1.0),
             ];
             let axis = (corners[0] + corners[3]).normalize();
-            let cos_min = corners
+            let cos = corners
                 .iter()
                 .map(|c| c.normalize().dot(axis))
-                .fold(1.0f64, f64::min);
-            // Widen by a fraction of the cell: query rounding lands near borders.
-            let half = cos_min.clamp(-1.0, 1.0).acos() * 1.05 + 1e-6;
-            (axis, half.cos(), half.sin())
+                .fold(1.0f64, f64::min)
+                .clamp(0.0, 1.0);
+            let sin = (1.0 - cos * cos).sqrt();
+            // Widened by a fraction of the cell, as queries' rounding lands near
+            // borders: the half-angle θ grows by δ ≥ 0.05·θ + 10⁻⁶ (tan θ ≥ θ), and the
+            // widened angle's cosine and sine are bounded without trigonometry, the
+            // cosine from below and the sine from above (cos δ ≥ 1 − δ²/2, sin δ ≤ δ),
+            // which only widens the cone further.
+            let delta = 0.05 * sin / cos + 1e-6;
+            (
+                axis,
+                cos * (1.0 - 0.5 * delta * delta) - sin * delta,
+                sin + cos * delta,
+            )
         };
         let half_n = n.div_ceil(2);
         let quarter = (0..half_n)
@@ -866,7 +877,7 @@ mod tests {
 
     use super::{
         cell_places, cell_ranges, coarser, face_rect, fewest_entries, most_entries, nearest_first,
-        only_face, silhouette_rect, DirGrid, Listed, ViewPyramid, COARSEST, ENTRIES_ANY,
+        only_face, silhouette_rect, CellCones, DirGrid, Listed, ViewPyramid, COARSEST, ENTRIES_ANY,
         ENTRIES_PER_SPHERE, MOST_WIDE, SPHERES_PER_BUCKET, SPHERES_PER_RUN, WIDEN,
     };
 
@@ -1143,6 +1154,35 @@ mod tests {
             compared += 1;
         }
         assert!(compared > 100_000, "{compared}");
+    }
+
+    /// A cell's cone holds every direction through the cell widened by 5% of its
+    /// half-angle and 10⁻⁶: its cosine is at most, and its sine at least, those of that
+    /// angle (worked out with trigonometry, the corner farthest from the axis giving
+    /// the half-angle), and not wider than 10% and 2·10⁻⁶ more.
+    #[test]
+    fn cell_cones_hold_the_cells_widened() {
+        for n in [1, 2, 3, 12, 64, 256] {
+            let cones = CellCones::new(n);
+            let at = |i: u32| f64::from(2 * i as i32 - n as i32) / f64::from(n);
+            for v in 0..cones.half_n {
+                for u in 0..cones.half_n {
+                    let (axis, cos, sin) = cones.quarter[(v * cones.half_n + u) as usize];
+                    let half = [(u, v), (u + 1, v), (u, v + 1), (u + 1, v + 1)]
+                        .map(|(a, b)| {
+                            DVec3::new(at(a), at(b), 1.0)
+                                .normalize()
+                                .angle_between(axis)
+                        })
+                        .into_iter()
+                        .fold(0.0f64, f64::max);
+                    let least = half * 1.05 + 1e-6;
+                    let most = half * 1.1 + 2e-6;
+                    assert!(cos <= least.cos() && sin >= least.sin(), "n {n} ({u}, {v})");
+                    assert!(cos >= most.cos() && sin <= most.sin(), "n {n} ({u}, {v})");
+                }
+            }
+        }
     }
 
     fn face_axes(face: u32) -> (usize, f64, usize, usize) {
