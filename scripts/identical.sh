@@ -8,8 +8,9 @@
 #   diff -r /tmp/before /tmp/after && echo identical
 #
 # The set: hw3 at 1 and 4 spp and at --quality default, many_1000/10000/100000
-# (../shared/peers/make_hw3.py), four close views of hw3 at depth 8, and the stress
-# scenes of assets/scenes/stress; each as PPM, PNG and EXR.
+# (../shared/peers/make_hw3.py) and many_100000 at 160×90 and 16×9, four close
+# views of hw3 at depth 8, and the stress scenes of assets/scenes/stress; each as
+# PPM, PNG and EXR.
 set -euo pipefail
 BIN=$(realpath "$1")
 OUT=$2
@@ -43,6 +44,10 @@ render hw3 ""
 render hw3-spp4 "" --spp 4
 render hw3-quality-default "" --quality default --width 640 --height 360
 for n in 1000 10000 100000; do render "many_$n" "$SCN/many_$n.toml"; done
+# Small images of many spheres: runs of rays parting too far to walk as bundles.
+for size in 160x90 16x9; do
+    render "many_100000-$size" "$SCN/many_100000.toml" --width "${size%x*}" --height "${size#*x}"
+done
 for v in close-glass close-mirror close-ground close-above; do
     render "$v" "$SCN/$v.toml" --width 640 --height 360
 done

@@ -291,7 +291,8 @@ impl FastTracer {
     }
 
     /// [`SampleTracer::sample_row`] when the eye has no grid: each run's rays walk the
-    /// hierarchy as one bundle ([`crate::accel::Spheres::closest_bundle`]). Out of
+    /// hierarchy as one bundle ([`crate::accel::Spheres::closest_bundle`]), or two at a
+    /// time alone when they part too far ([`close_enough_to_bundle`]). Out of
     /// line, so that `sample_row`'s loop for the eye's grid compiles as it would
     /// alone (with this loop inside it, hw3 took 2% more instructions; with
     /// `shade_run` for its own shading, 0.5% more).
@@ -303,14 +304,19 @@ impl FastTracer {
         out: &mut [Vec3],
         counts: &mut RayCounts,
     ) {
+        let spheres = &self.compiled.spheres;
         let mut dirs = [Vec3::ZERO; RUN];
         for (s, out) in s.chunks(RUN).zip(out.chunks_mut(RUN)) {
             camera.directions(s, &mut dirs);
             let dirs = &dirs[..s.len()];
+            if !close_enough_to_bundle(dirs[0], dirs[s.len() - 1]) {
+                self.shade_run(dirs, out, counts, |a, b| {
+                    spheres.closest_from_eye_pair(&self.eye, a, b)
+                });
+                continue;
+            }
             let mut hits = [None; BUNDLE];
-            self.compiled
-                .spheres
-                .closest_bundle(self.origin, dirs, &mut hits[..s.len()]);
+            spheres.closest_bundle(self.origin, dirs, &mut hits[..s.len()]);
             let mut pairs = hits.chunks(2);
             self.shade_run(dirs, out, counts, |_, _| {
                 let h = pairs.next().expect("a pair of hits a pair of directions");
@@ -379,6 +385,19 @@ impl FastTracer {
         [local(ma, cos_a, shadows[0]), local(mb, cos_b, shadows[1])]
     }
 }
+
+/// Whether the rays of a run, its end directions `first` and `last` (unit vectors), part
+/// by little enough to walk the hierarchy as a bundle: by at most about 1.4° (a run of
+/// 8 pixels of a row at a 68° field of view and 320 pixels across). A bundle's boxes are
+/// tested against the interval of its rays' directions, which at wider angles (a small
+/// image, or the viewer's preview, one pixel of each block) lets through much of the
+/// hierarchy (a million balls at 16×9 take 50 times as long in bundles as ray by ray).
+fn close_enough_to_bundle(first: Vec3, last: Vec3) -> bool {
+    first.dot(last) >= BUNDLE_LEAST_COS
+}
+
+/// The least cosine between a bundle's end directions ([`close_enough_to_bundle`]).
+const BUNDLE_LEAST_COS: f32 = 0.9997;
 
 /// The largest colour component any trace can return: sky colours and, for local
 /// shading, the sum over lights of the brightest component (kd ≤ 1, cos ≤ 1, s ≤ 1).
@@ -471,43 +490,64 @@ mod tests {
     #[test]
     fn rows_in_bundles_give_each_pixel_its_own_colour() {
         let scene = crate::scene::many_scene(70_000);
-        let (width, height) = (317u32, 60u32);
-        let tracer = FastTracer::new(&scene, &scene.camera(width, height).unwrap(), 5);
-        assert!(tracer.eye.walks_in_bundles());
-        let s: Vec<f32> = (0..width)
-            .map(|x| (x as f32 + 0.5) / width as f32)
-            .collect();
-        let mut counts = RayCounts::default();
-        let mut sky = 0;
-        for j in 0..height {
-            let t = (j as f32 + 0.5) / height as f32;
-            let mut row = vec![Vec3::ZERO; s.len()];
-            let mut row_counts = RayCounts::default();
-            tracer.sample_row(&s, t, &mut row, &mut row_counts);
-            assert_eq!(
-                row_counts.primary,
-                u64::from(width),
-                "a primary ray a pixel"
-            );
-            for (&s, got) in s.iter().zip(row) {
-                let want = tracer.sample(s, t, &mut counts);
-                assert_eq!(got.to_array(), want.to_array(), "pixel at ({s}, {t})");
-                let dir = model::primary_direction(
-                    tracer.corner,
-                    tracer.horizontal,
-                    tracer.vertical,
-                    s,
-                    t,
+        // Runs of 8 pixels as bundles (1280 across), ray by ray (40 across), and both
+        // (317 across: the parting of a run's rays grows from the image's edges to
+        // its centre).
+        let (mut bundled, mut alone, mut sky) = (0, 0, 0);
+        for (width, height) in [(1280u32, 6u32), (317, 30), (40, 40)] {
+            let tracer = FastTracer::new(&scene, &scene.camera(width, height).unwrap(), 5);
+            assert!(tracer.eye.walks_in_bundles());
+            let s: Vec<f32> = (0..width)
+                .map(|x| (x as f32 + 0.5) / width as f32)
+                .collect();
+            let mut counts = RayCounts::default();
+            for j in 0..height {
+                let t = (j as f32 + 0.5) / height as f32;
+                let mut row = vec![Vec3::ZERO; s.len()];
+                let mut row_counts = RayCounts::default();
+                tracer.sample_row(&s, t, &mut row, &mut row_counts);
+                assert_eq!(
+                    row_counts.primary,
+                    u64::from(width),
+                    "a primary ray a pixel"
                 );
-                sky += usize::from(
-                    got == model::sky(dir, tracer.compiled.sky_down, tracer.compiled.sky_up),
-                );
+                let dir = |s: f32| {
+                    model::primary_direction(
+                        tracer.corner,
+                        tracer.horizontal,
+                        tracer.vertical,
+                        s,
+                        t,
+                    )
+                };
+                for run in s.chunks(RUN) {
+                    if close_enough_to_bundle(dir(run[0]), dir(run[run.len() - 1])) {
+                        bundled += 1;
+                    } else {
+                        alone += 1;
+                    }
+                }
+                for (&s, got) in s.iter().zip(row) {
+                    let want = tracer.sample(s, t, &mut counts);
+                    assert_eq!(
+                        got.to_array(),
+                        want.to_array(),
+                        "pixel at ({s}, {t}) of {width}×{height}"
+                    );
+                    sky += usize::from(
+                        got == model::sky(dir(s), tracer.compiled.sky_down, tracer.compiled.sky_up),
+                    );
+                }
             }
         }
+        assert!(
+            bundled > 1000 && alone > 200,
+            "{bundled} runs bundled, {alone} alone"
+        );
         assert!(sky > 100 && sky < 15_000, "{sky} pixels of sky");
         // At the grid's size, the eye keeps its grid.
         let scene = crate::scene::many_scene(65_532);
-        let tracer = FastTracer::new(&scene, &scene.camera(width, height).unwrap(), 5);
+        let tracer = FastTracer::new(&scene, &scene.camera(317, 60).unwrap(), 5);
         assert!(!tracer.eye.walks_in_bundles());
     }
 
