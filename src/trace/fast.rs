@@ -479,14 +479,12 @@ mod tests {
     use crate::accel::exact_tests;
     use crate::scene::{hw3_scene, Sphere, HW3_DEFAULT_SEED};
 
-    /// The tracer builds its eye's grid for the camera's view: a ball behind the camera
-    /// is left out of it (no primary ray could meet it), while the balls in front are
-    /// listed.
-    /// Above the eye grid's size the rows' primary rays walk the hierarchy in bundles:
-    /// each pixel of a row gets the colour `sample` gives it alone, to the bit, over
-    /// the peers' scene of 70,000 balls (sky, small balls of every material, the big
-    /// glass, mirror and diffuse balls, the ground), in rows of 317 pixels (runs of
-    /// eight and one of five), one primary ray a pixel; 65,536 spheres keep the grid.
+    /// Above the eye grid's size the rows' primary rays walk the hierarchy in bundles,
+    /// or alone where a run's rays part too far: each pixel of a row gets the colour
+    /// `sample` gives it alone, to the bit, over the peers' scene of 70,000 balls (sky,
+    /// small balls of every material, the big glass, mirror and diffuse balls, the
+    /// ground), in rows of 1280, 317 (runs of eight and one of five) and 40 pixels, one
+    /// primary ray a pixel; 65,536 spheres keep the grid.
     #[test]
     fn rows_in_bundles_give_each_pixel_its_own_colour() {
         let scene = crate::scene::many_scene(70_000);
@@ -551,6 +549,9 @@ mod tests {
         assert!(!tracer.eye.walks_in_bundles());
     }
 
+    /// The tracer builds its eye's grid for the camera's view: a ball behind the camera
+    /// is left out of it (no primary ray could meet it), while the balls in front are
+    /// listed.
     #[test]
     fn the_eye_s_grid_leaves_out_a_ball_behind_the_camera() {
         let mut scene = hw3_scene(HW3_DEFAULT_SEED);
