@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
 
 use super::bands::for_each_row;
-use super::film::film;
+use super::film::each_sample;
 use super::resolve::pixel_value;
 use super::{Frame, RenderControl, RenderError, Traced};
 use crate::sampling::sample_offset;
@@ -153,10 +153,17 @@ pub(super) fn adaptive<T: SampleTracer>(
         |j, row, counts| {
             for (o, p) in row.chunks_mut(nf).enumerate() {
                 let i = outer.x + o as u32;
-                for (slot, &k) in p.iter_mut().zip(&first) {
-                    let (s, t) = film(settings, i, j, k);
-                    *slot = tracer.sample_bounded(s, t, counts);
-                }
+                let mut slots = p.iter_mut();
+                each_sample(
+                    tracer,
+                    settings,
+                    (i, j),
+                    first.iter().copied(),
+                    counts,
+                    |_, v| {
+                        *slots.next().expect("a slot a first sample") = v;
+                    },
+                );
             }
             let means: Vec<Vec3> = row.chunks(nf).map(mean).collect();
             let differs = |o: usize, q: usize| reaches((means[q] - means[o]).abs().max_element());
@@ -206,17 +213,28 @@ pub(super) fn adaptive<T: SampleTracer>(
         let mut sum = Vec3::ZERO;
         let mut bound = 0.0f32;
         if refine[ay * area.width as usize + ax] {
-            let mut next = 0;
-            for k in 0..spp {
-                let (c, b) = if next < nf && first[next] == k {
-                    next += 1;
-                    stored[next - 1]
-                } else {
-                    let (s, t) = film(settings, i, j, k);
-                    tracer.sample_bounded(s, t, counts)
-                };
+            // The samples not stored, traced two at a time; the sums take every sample
+            // in index order, the stored ones in their places between them.
+            let mut add = |(c, b): (Vec3, f32)| {
                 sum += c;
                 bound += b;
+            };
+            let mut taken = 0;
+            let rest = (0..spp).filter(|&k| {
+                let is_first = taken < nf && first[taken] == k;
+                taken += usize::from(is_first);
+                !is_first
+            });
+            let mut next = 0;
+            each_sample(tracer, settings, (i, j), rest, counts, |k, v| {
+                while next < nf && first[next] < k {
+                    add(stored[next]);
+                    next += 1;
+                }
+                add(v);
+            });
+            for &v in &stored[next..] {
+                add(v);
             }
             *p = (pixel_value(sum, spp), bound / spp as f32);
         } else {

@@ -2,8 +2,11 @@
 //! `s = (i + sx)/W`, `t = (j + sy)/H`, with `j` counted from the bottom and the
 //! offsets of [`crate::sampling`]. One sample a pixel is the pixel's centre.
 
+use glam::Vec3;
+
 use crate::sampling::sample_offset;
 use crate::settings::{Region, Settings};
+use crate::trace::{RayCounts, SampleTracer};
 
 /// The film abscissae of the centres of the area's columns: `film`'s `s` for one
 /// sample a pixel (the same values), worked out once.
@@ -33,4 +36,31 @@ pub(crate) fn film(settings: &Settings, i: u32, j: u32, k: u32) -> (f32, f32) {
         (i as f32 + sx) / settings.width as f32,
         (j as f32 + sy) / settings.height as f32,
     )
+}
+
+/// The samples `ks` of pixel `(i, j)` in their order, each index with its (colour,
+/// cutoff bound) given to `each`: two at a time through
+/// [`SampleTracer::sample_bounded_pair`], the same values as one by one.
+#[inline]
+pub(crate) fn each_sample<T: SampleTracer + ?Sized>(
+    tracer: &T,
+    settings: &Settings,
+    (i, j): (u32, u32),
+    ks: impl IntoIterator<Item = u32>,
+    counts: &mut RayCounts,
+    mut each: impl FnMut(u32, (Vec3, f32)),
+) {
+    let mut ks = ks.into_iter();
+    while let Some(k) = ks.next() {
+        let (s, t) = film(settings, i, j, k);
+        match ks.next() {
+            Some(next) => {
+                let (s_next, t_next) = film(settings, i, j, next);
+                let [a, b] = tracer.sample_bounded_pair([s, s_next], [t, t_next], counts);
+                each(k, a);
+                each(next, b);
+            }
+            None => each(k, tracer.sample_bounded(s, t, counts)),
+        }
+    }
 }

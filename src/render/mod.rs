@@ -29,7 +29,7 @@ use crate::trace::reference::ReferenceTracer;
 use crate::trace::{RayCounts, SampleTracer};
 use adaptive::adaptive;
 use bands::{for_each_pixel, for_each_row, for_each_row_of_bytes, in_pool, BAND_ROWS};
-use film::{centre_height, film, pixel_centres};
+use film::{centre_height, each_sample, pixel_centres};
 
 pub use adaptive::first_pass_samples;
 use frame::bytes_of_row;
@@ -424,10 +424,9 @@ fn render_with<T: SampleTracer>(
                     for (a, p) in row.iter_mut().enumerate() {
                         let i = area.x + a as u32;
                         let mut sum = Vec3::ZERO;
-                        for k in 0..spp {
-                            let (s, t) = film(settings, i, j, k);
-                            sum += tracer.sample(s, t, counts);
-                        }
+                        each_sample(tracer, settings, (i, j), 0..spp, counts, |_, (c, _)| {
+                            sum += c;
+                        });
                         *p = pixel_value(sum, spp);
                     }
                 },
@@ -450,12 +449,10 @@ fn render_with<T: SampleTracer>(
                 u64::from(spp),
                 control,
                 |i, j, (sum, bound), counts| {
-                    for k in 0..spp {
-                        let (s, t) = film(settings, i, j, k);
-                        let (c, b) = tracer.sample_bounded(s, t, counts);
+                    each_sample(tracer, settings, (i, j), 0..spp, counts, |_, (c, b)| {
                         *sum += c;
                         *bound += b;
-                    }
+                    });
                 },
             )?;
             let (pixels, bounds) = in_pool(settings, || {

@@ -7,7 +7,7 @@ use std::ops::Range;
 use glam::Vec3;
 
 use super::bands::{for_each_pixel, for_each_row};
-use super::film::{centre_height, centres_of, film};
+use super::film::{centre_height, centres_of, each_sample, film};
 use super::{RenderControl, RenderError};
 use crate::settings::Settings;
 use crate::trace::{RayCounts, SampleTracer};
@@ -56,10 +56,16 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
         if afresh {
             *sum = Vec3::ZERO;
         }
-        for k in samples.clone() {
-            let (s, t) = film(settings, i, j, k);
-            *sum += tracer.sample(s, t, counts);
-        }
+        each_sample(
+            tracer,
+            settings,
+            (i, j),
+            samples.clone(),
+            counts,
+            |_, (c, _)| {
+                *sum += c;
+            },
+        );
     })
 }
 

@@ -412,6 +412,30 @@ impl SampleTracer for FastTracer {
         self.sample_bounded(s, t, counts).0
     }
 
+    /// Two samples' primary rays through the eye's query as a pair, their hits shaded
+    /// as a pair (`shade_pair`): the chains of square roots, divisions and loads of the
+    /// two overlap.
+    fn sample_bounded_pair(
+        &self,
+        s: [f32; 2],
+        t: [f32; 2],
+        counts: &mut RayCounts,
+    ) -> [(Vec3, f32); 2] {
+        if self.max_depth == 0 || self.cutoff != 0.0 {
+            let first = self.sample_bounded(s[0], t[0], counts);
+            return [first, self.sample_bounded(s[1], t[1], counts)];
+        }
+        let dir = |k: usize| {
+            model::primary_direction(self.corner, self.horizontal, self.vertical, s[k], t[k])
+        };
+        let (a, b) = (dir(0), dir(1));
+        let hits = self.compiled.spheres.closest_from_eye_pair(&self.eye, a, b);
+        counts.primary += 2;
+        // No cutoff: nothing is skipped, so each bound is `sample_bounded`'s, zero.
+        let [ca, cb] = self.shade_pair([a, b], &hits, counts);
+        [(ca, 0.0), (cb, 0.0)]
+    }
+
     fn sample_row(&self, s: &[f32], t: f32, out: &mut [Vec3], counts: &mut RayCounts) {
         if self.max_depth == 0 || self.cutoff != 0.0 {
             // Nothing to share: every sample as `sample` takes it.
@@ -547,6 +571,59 @@ mod tests {
         let scene = crate::scene::many_scene(65_532);
         let tracer = FastTracer::new(&scene, &scene.camera(317, 60).unwrap(), 5);
         assert!(!tracer.eye.walks_in_bundles());
+    }
+
+    /// Two samples at once give what each gives alone, to the bit, with the same ray
+    /// counts: pairs of film positions near each other (as a pixel's samples) and far
+    /// apart, on hw3 (through the eye's grid), on 70,000 balls (no grid: the
+    /// hierarchy), and with a contribution cutoff (each sample alone, with its bound).
+    #[test]
+    fn a_pair_of_samples_is_each_sample_alone() {
+        let hw3 = hw3_scene(HW3_DEFAULT_SEED);
+        let many = crate::scene::many_scene(70_000);
+        let mut rng = rand_mt::Mt64::new(5);
+        let mut unit = move || (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
+        for (scene, cutoff) in [(&hw3, 0.0), (&many, 0.0), (&hw3, 0.05)] {
+            let camera = scene.camera(64, 36).unwrap();
+            let tracer = FastTracer::new(scene, &camera, 5).with_cutoff(cutoff);
+            let (mut alone, mut paired) = (RayCounts::default(), RayCounts::default());
+            let (mut hits, mut bounded) = (0, 0);
+            for n in 0..4000 {
+                let (s0, t0) = (unit(), unit());
+                let (s1, t1) = if n % 2 == 0 {
+                    (0.98 * s0 + 0.02 * unit(), 0.98 * t0 + 0.02 * unit())
+                } else {
+                    (unit(), unit())
+                };
+                let want = [
+                    tracer.sample_bounded(s0, t0, &mut alone),
+                    tracer.sample_bounded(s1, t1, &mut alone),
+                ];
+                let got = tracer.sample_bounded_pair([s0, s1], [t0, t1], &mut paired);
+                for (got, want) in got.iter().zip(&want) {
+                    assert_eq!(
+                        (got.0.to_array(), got.1),
+                        (want.0.to_array(), want.1),
+                        "({s0}, {t0}) and ({s1}, {t1})"
+                    );
+                }
+                let sky = |s: f32, t: f32, c: Vec3| {
+                    let dir = model::primary_direction(
+                        tracer.corner,
+                        tracer.horizontal,
+                        tracer.vertical,
+                        s,
+                        t,
+                    );
+                    c == model::sky(dir, tracer.compiled.sky_down, tracer.compiled.sky_up)
+                };
+                hits += usize::from(!sky(s0, t0, want[0].0) && !sky(s1, t1, want[1].0));
+                bounded += usize::from(want[0].1 > 0.0);
+            }
+            assert_eq!(paired, alone);
+            assert!(hits > 1000, "{hits} pairs of hits");
+            assert_eq!(bounded > 0, cutoff > 0.0, "{bounded} bounded");
+        }
     }
 
     /// The tracer builds its eye's grid for the camera's view: a ball behind the camera

@@ -46,6 +46,18 @@ pub trait SampleTracer: Sync {
         (self.sample(s, t, counts), 0.0)
     }
 
+    /// `[sample_bounded(s[0], t[0]), sample_bounded(s[1], t[1])]`: two samples at once,
+    /// the same values as one by one (a tracer may overlap the two samples' work).
+    fn sample_bounded_pair(
+        &self,
+        s: [f32; 2],
+        t: [f32; 2],
+        counts: &mut RayCounts,
+    ) -> [(Vec3, f32); 2] {
+        let first = self.sample_bounded(s[0], t[0], counts);
+        [first, self.sample_bounded(s[1], t[1], counts)]
+    }
+
     /// `out[i] = sample(s[i], t)`: a row of samples at one height, the same colours
     /// as one by one (a tracer may share work between neighbours).
     fn sample_row(&self, s: &[f32], t: f32, out: &mut [Vec3], counts: &mut RayCounts) {
