@@ -31,13 +31,12 @@ pub(crate) fn first_samples<T: SampleTracer + ?Sized>(
     // Two pixels at a time (`SampleTracer::sample_bounded_pair`), each sum from zero
     // as `accumulate` starts it.
     for (columns, sums) in columns.chunks(2).zip(out.chunks_mut(2)) {
-        let at = |n: usize| film(settings, columns[n], j, 0);
+        let (s, t) = film(settings, columns[0], j, 0);
         if let [a, b] = sums {
-            let ((sa, ta), (sb, tb)) = (at(0), at(1));
-            let [(ca, _), (cb, _)] = tracer.sample_bounded_pair([sa, sb], [ta, tb], counts);
+            let (s_next, t_next) = film(settings, columns[1], j, 0);
+            let [(ca, _), (cb, _)] = tracer.sample_bounded_pair([s, s_next], [t, t_next], counts);
             (*a, *b) = (Vec3::ZERO + ca, Vec3::ZERO + cb);
         } else {
-            let (s, t) = at(0);
             sums[0] = Vec3::ZERO + tracer.sample(s, t, counts);
         }
     }
