@@ -576,16 +576,22 @@ mod tests {
     /// Two samples at once give what each gives alone, to the bit, with the same ray
     /// counts: pairs of film positions near each other (as a pixel's samples) and far
     /// apart, on hw3 (through the eye's grid), on 70,000 balls (no grid: the
-    /// hierarchy), and with a contribution cutoff (each sample alone, with its bound).
+    /// hierarchy), with a contribution cutoff (each sample alone, with its bound), and
+    /// at depth 0 (every sample the sky).
     #[test]
     fn a_pair_of_samples_is_each_sample_alone() {
         let hw3 = hw3_scene(HW3_DEFAULT_SEED);
         let many = crate::scene::many_scene(70_000);
         let mut rng = rand_mt::Mt64::new(5);
         let mut unit = move || (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
-        for (scene, cutoff) in [(&hw3, 0.0), (&many, 0.0), (&hw3, 0.05)] {
+        for (scene, cutoff, depth) in [
+            (&hw3, 0.0, 5),
+            (&many, 0.0, 5),
+            (&hw3, 0.05, 5),
+            (&hw3, 0.0, 0),
+        ] {
             let camera = scene.camera(64, 36).unwrap();
-            let tracer = FastTracer::new(scene, &camera, 5).with_cutoff(cutoff);
+            let tracer = FastTracer::new(scene, &camera, depth).with_cutoff(cutoff);
             let (mut alone, mut paired) = (RayCounts::default(), RayCounts::default());
             let (mut hits, mut bounded) = (0, 0);
             for n in 0..4000 {
@@ -621,7 +627,11 @@ mod tests {
                 bounded += usize::from(want[0].1 > 0.0);
             }
             assert_eq!(paired, alone);
-            assert!(hits > 1000, "{hits} pairs of hits");
+            assert_eq!(
+                hits > 1000,
+                depth > 0,
+                "{hits} pairs of hits at depth {depth}"
+            );
             assert_eq!(bounded > 0, cutoff > 0.0, "{bounded} bounded");
         }
     }
