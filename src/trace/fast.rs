@@ -422,8 +422,7 @@ impl SampleTracer for FastTracer {
         counts: &mut RayCounts,
     ) -> [(Vec3, f32); 2] {
         if self.max_depth == 0 || self.cutoff != 0.0 {
-            let first = self.sample_bounded(s[0], t[0], counts);
-            return [first, self.sample_bounded(s[1], t[1], counts)];
+            return super::one_by_one(self, s, t, counts);
         }
         let dir = |k: usize| {
             model::primary_direction(self.corner, self.horizontal, self.vertical, s[k], t[k])

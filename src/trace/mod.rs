@@ -54,8 +54,7 @@ pub trait SampleTracer: Sync {
         t: [f32; 2],
         counts: &mut RayCounts,
     ) -> [(Vec3, f32); 2] {
-        let first = self.sample_bounded(s[0], t[0], counts);
-        [first, self.sample_bounded(s[1], t[1], counts)]
+        one_by_one(self, s, t, counts)
     }
 
     /// `out[i] = sample(s[i], t)`: a row of samples at one height, the same colours
@@ -65,4 +64,15 @@ pub trait SampleTracer: Sync {
             *o = self.sample(s, t, counts);
         }
     }
+}
+
+/// [`SampleTracer::sample_bounded_pair`] as two samples, one after the other.
+pub(crate) fn one_by_one<T: SampleTracer + ?Sized>(
+    tracer: &T,
+    s: [f32; 2],
+    t: [f32; 2],
+    counts: &mut RayCounts,
+) -> [(Vec3, f32); 2] {
+    let first = tracer.sample_bounded(s[0], t[0], counts);
+    [first, tracer.sample_bounded(s[1], t[1], counts)]
 }
