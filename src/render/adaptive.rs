@@ -219,12 +219,7 @@ pub(super) fn adaptive<T: SampleTracer>(
                 sum += c;
                 bound += b;
             };
-            let mut taken = 0;
-            let rest = (0..spp).filter(|&k| {
-                let is_first = taken < nf && first[taken] == k;
-                taken += usize::from(is_first);
-                !is_first
-            });
+            let rest = (0..spp).filter(|k| first.binary_search(k).is_err());
             let mut next = 0;
             each_sample(tracer, settings, (i, j), rest, counts, |k, v| {
                 while next < nf && first[next] < k {

@@ -39,8 +39,7 @@ pub(crate) fn film(settings: &Settings, i: u32, j: u32, k: u32) -> (f32, f32) {
 }
 
 /// The samples `ks` of pixel `(i, j)` in their order, each index with its (colour,
-/// cutoff bound) given to `each`: two at a time through
-/// [`SampleTracer::sample_bounded_pair`], the same values as one by one.
+/// cutoff bound) given to `each`, two at a time ([`in_pairs`]).
 #[inline]
 pub(crate) fn each_sample<T: SampleTracer + ?Sized>(
     tracer: &T,
@@ -48,19 +47,31 @@ pub(crate) fn each_sample<T: SampleTracer + ?Sized>(
     (i, j): (u32, u32),
     ks: impl IntoIterator<Item = u32>,
     counts: &mut RayCounts,
-    mut each: impl FnMut(u32, (Vec3, f32)),
+    each: impl FnMut(u32, (Vec3, f32)),
 ) {
-    let mut ks = ks.into_iter();
-    while let Some(k) = ks.next() {
-        let (s, t) = film(settings, i, j, k);
-        match ks.next() {
-            Some(next) => {
-                let (s_next, t_next) = film(settings, i, j, next);
+    let at = ks.into_iter().map(|k| (k, film(settings, i, j, k)));
+    in_pairs(tracer, at, counts, each);
+}
+
+/// Each film position of `at` traced, in order, its (colour, cutoff bound) given to
+/// `each` with its tag: two at a time through [`SampleTracer::sample_bounded_pair`],
+/// the same values as one by one.
+#[inline]
+pub(crate) fn in_pairs<T: SampleTracer + ?Sized, Tag>(
+    tracer: &T,
+    at: impl IntoIterator<Item = (Tag, (f32, f32))>,
+    counts: &mut RayCounts,
+    mut each: impl FnMut(Tag, (Vec3, f32)),
+) {
+    let mut at = at.into_iter();
+    while let Some((tag, (s, t))) = at.next() {
+        match at.next() {
+            Some((next, (s_next, t_next))) => {
                 let [a, b] = tracer.sample_bounded_pair([s, s_next], [t, t_next], counts);
-                each(k, a);
+                each(tag, a);
                 each(next, b);
             }
-            None => each(k, tracer.sample_bounded(s, t, counts)),
+            None => each(tag, tracer.sample_bounded(s, t, counts)),
         }
     }
 }

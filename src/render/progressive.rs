@@ -7,7 +7,7 @@ use std::ops::Range;
 use glam::Vec3;
 
 use super::bands::{for_each_pixel, for_each_row};
-use super::film::{centre_height, centres_of, each_sample, film};
+use super::film::{centre_height, centres_of, each_sample, film, in_pairs};
 use super::{RenderControl, RenderError};
 use crate::settings::Settings;
 use crate::trace::{RayCounts, SampleTracer};
@@ -28,18 +28,15 @@ pub(crate) fn first_samples<T: SampleTracer + ?Sized>(
         tracer.sample_row(centres, centre_height(settings, j), out, counts);
         return;
     }
-    // Two pixels at a time (`SampleTracer::sample_bounded_pair`), each sum from zero
-    // as `accumulate` starts it.
-    for (columns, sums) in columns.chunks(2).zip(out.chunks_mut(2)) {
-        let (s, t) = film(settings, columns[0], j, 0);
-        if let [a, b] = sums {
-            let (s_next, t_next) = film(settings, columns[1], j, 0);
-            let [(ca, _), (cb, _)] = tracer.sample_bounded_pair([s, s_next], [t, t_next], counts);
-            (*a, *b) = (Vec3::ZERO + ca, Vec3::ZERO + cb);
-        } else {
-            sums[0] = Vec3::ZERO + tracer.sample(s, t, counts);
-        }
-    }
+    // Two pixels at a time, each sum from zero as `accumulate` starts it.
+    let at = columns
+        .iter()
+        .zip(out)
+        .map(|(&i, sum)| (sum, film(settings, i, j, 0)));
+    in_pairs(tracer, at, counts, |sum, (c, _)| {
+        *sum = Vec3::ZERO;
+        *sum += c;
+    });
 }
 
 /// Sums samples `samples` of every pixel of the area into `sums` (area-sized, row 0 at
