@@ -22,23 +22,82 @@ const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 /// The offset in `[0,1)²` of sample `k` of `spp` in pixel `(i, j)`.
 #[inline]
 pub fn sample_offset(i: u32, j: u32, k: u32, spp: u32, seed: u64) -> (f32, f32) {
-    if spp <= 1 {
-        return (0.5, 0.5);
+    Strata::new(spp).offset(i, j, k, seed)
+}
+
+/// The cells that stratify a pixel's samples ([`sample_offset`]), worked out once for
+/// all the pixels of a render.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Strata {
+    spp: u32,
+    nx: u32,
+    ny: u32,
+}
+
+impl Strata {
+    pub(crate) fn new(spp: u32) -> Strata {
+        // nx × ny cells cover the pixel (one for a sample at its centre).
+        let nx = (spp.max(1) as f32).sqrt().ceil() as u32;
+        Strata {
+            spp,
+            nx,
+            ny: spp.max(1).div_ceil(nx),
+        }
     }
-    // nx × ny cells cover the pixel. When spp < nx·ny some cells stay empty; so that
-    // no part of the pixel is favoured, the spp cells taken run on from a start drawn
-    // per pixel: every cell is then equally likely to be sampled (no bias).
-    let nx = (spp as f32).sqrt().ceil() as u32;
-    let ny = spp.div_ceil(nx);
-    let cells = nx * ny;
-    let start = (hash(i, j, u32::MAX, seed) % u64::from(cells)) as u32;
-    let cell = (k + start) % cells;
-    let (cx, cy) = (cell % nx, cell / nx);
-    let h = hash(i, j, k, seed);
-    let unit = |bits: u64| (bits & 0xff_ffff) as f32 * (1.0 / 16_777_216.0);
-    let sx = (cx as f32 + unit(h)) / nx as f32;
-    let sy = (cy as f32 + unit(h >> 32)) / ny as f32;
-    (sx.min(BELOW_ONE), sy.min(BELOW_ONE))
+
+    /// [`sample_offset`] of sample `k` of pixel `(i, j)`.
+    #[inline]
+    pub(crate) fn offset(&self, i: u32, j: u32, k: u32, seed: u64) -> (f32, f32) {
+        self.of_pixel(i, j, seed).offset(k)
+    }
+
+    /// What the samples of pixel `(i, j)` share: where their cells start.
+    #[inline]
+    pub(crate) fn of_pixel(&self, i: u32, j: u32, seed: u64) -> PixelStrata {
+        // When spp < nx·ny some cells stay empty; so that no part of the pixel is
+        // favoured, the spp cells taken run on from a start drawn per pixel: every
+        // cell is then equally likely to be sampled (no bias).
+        let cells = self.nx * self.ny;
+        let start = if self.spp <= 1 {
+            0
+        } else {
+            (hash(i, j, u32::MAX, seed) % u64::from(cells)) as u32
+        };
+        PixelStrata {
+            strata: *self,
+            pixel: (i, j),
+            seed,
+            start,
+        }
+    }
+}
+
+/// The strata of one pixel's samples ([`Strata::of_pixel`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PixelStrata {
+    strata: Strata,
+    pixel: (u32, u32),
+    seed: u64,
+    start: u32,
+}
+
+impl PixelStrata {
+    /// [`sample_offset`] of sample `k` of the pixel.
+    #[inline]
+    pub(crate) fn offset(&self, k: u32) -> (f32, f32) {
+        let Strata { spp, nx, ny } = self.strata;
+        if spp <= 1 {
+            return (0.5, 0.5);
+        }
+        let cell = (k + self.start) % (nx * ny);
+        let (cx, cy) = (cell % nx, cell / nx);
+        let ((i, j), seed) = (self.pixel, self.seed);
+        let h = hash(i, j, k, seed);
+        let unit = |bits: u64| (bits & 0xff_ffff) as f32 * (1.0 / 16_777_216.0);
+        let sx = (cx as f32 + unit(h)) / nx as f32;
+        let sy = (cy as f32 + unit(h >> 32)) / ny as f32;
+        (sx.min(BELOW_ONE), sy.min(BELOW_ONE))
+    }
 }
 
 #[cfg(test)]

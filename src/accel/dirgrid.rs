@@ -587,23 +587,29 @@ impl<T: Copy + Send + Sync> DirGrid<T> {
         }
     }
 
-    /// Whether the cells at `a` and `b`, on one face, and every cell of that face
-    /// between them (the rectangle of columns and rows they span) list no sphere. The
-    /// directions between two that fall at `a` and `b` (the segment between them)
-    /// project into that rectangle: a face's pyramid is convex, and central projection
-    /// takes a segment to a segment.
+    /// Whether the cells at `places`, all on one face, and every cell of that face
+    /// among them (the rectangle of columns and rows they span) list no sphere. The
+    /// directions among some that fall at `places` (a segment between two, a
+    /// parallelogram's corners) project into that rectangle: a face's pyramid is
+    /// convex, and central projection takes the segment or the parallelogram to a
+    /// segment or a convex quadrilateral with the projected ends or corners.
     #[inline]
-    pub(super) fn lists_nothing_between(&self, a: CellPlace, b: CellPlace) -> bool {
-        if a.face != b.face {
+    pub(super) fn lists_nothing_among(&self, places: &[CellPlace]) -> bool {
+        let face = places[0].face;
+        if places.iter().any(|p| p.face != face) {
             return false;
         }
-        let (u0, u1) = (a.u.min(b.u), a.u.max(b.u));
+        let span = |along: fn(&CellPlace) -> u32| {
+            let values = places.iter().map(along);
+            (values.clone().min().unwrap_or(0), values.max().unwrap_or(0))
+        };
+        let ((u0, u1), (v0, v1)) = (span(|p| p.u), span(|p| p.v));
         // A row of a face's cells is contiguous in the offsets: its columns `u0..=u1`
         // are empty when their first start equals their last end.
-        (a.v.min(b.v)..=a.v.max(b.v)).all(|v| {
+        (v0..=v1).all(|v| {
             let (first, last) = (
-                cell_index(a.face, u0, v, self.n),
-                cell_index(a.face, u1, v, self.n),
+                cell_index(face, u0, v, self.n),
+                cell_index(face, u1, v, self.n),
             );
             self.offsets[first] == self.offsets[last + 1]
         })

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 pub(crate) use bundle::BUNDLE;
 use bvh::{Aabb, Bvh};
 use dirgrid::DirGrid;
-pub(crate) use point::{EyeGrid, PointGrid};
+pub(crate) use point::{EyeArea, EyeGrid, PointGrid};
 pub(crate) use view::ViewPyramid;
 
 use crate::intersect::{power, roots};

@@ -114,6 +114,18 @@ impl EyeGrid {
         self.grid.is_some()
     }
 
+    /// The run of directions in `area` (from [`Spheres::eye_area`] of this grid).
+    #[inline]
+    pub(crate) fn run(&self, area: EyeArea) -> EyeRun<'_> {
+        match area {
+            EyeArea::Sky => EyeRun { candidates: &[] },
+            EyeArea::Cell(cell) => {
+                let grid = self.grid.as_ref().expect("a cell of this grid");
+                EyeRun::of_cell(grid, cell as usize)
+            }
+        }
+    }
+
     fn query(&self, d: Vec3) -> Query {
         Query {
             origin: self.centre,
@@ -146,6 +158,15 @@ impl<'a> EyeStart<'a> {
             candidates: run.candidates,
         }
     }
+}
+
+/// Where some directions from the eye all fall ([`Spheres::eye_area`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum EyeArea {
+    /// Nowhere a sphere can be met.
+    Sky,
+    /// In this one cell of the eye grid.
+    Cell(u32),
 }
 
 /// Directions from the eye that share one cell of its grid, such as the pixels of a
@@ -387,26 +408,43 @@ impl Spheres {
         ]
     }
 
-    /// When every direction from the eye between `a` and `b` (unit vectors; the
-    /// directions of one image row between two pixels, say) lies in one cell of the
-    /// eye grid, that cell, for [`Spheres::closest_in_run_pair`]: so when `a` and `b`
-    /// fall in one cell (a cell is a square in its face's plane, and the row's
-    /// directions between project to the segment between, inside it; cells list every
-    /// sphere seen within a widened cone, which covers the rounding of the directions
-    /// many times over) and the eye is inside no sphere. When they fall in different
-    /// cells of one face and no cell between lists a sphere, a run that sees nothing.
+    /// When every direction from the eye among `ends` (unit vectors: the directions
+    /// of one image row between two pixels) lies in one cell of the eye grid, that
+    /// cell, for [`Spheres::closest_in_run_pair`]; when they all see nothing, a run
+    /// that sees nothing ([`Spheres::eye_area`]).
     #[inline(never)]
-    pub(crate) fn eye_run<'a>(&self, eye: &'a EyeGrid, a: Vec3, b: Vec3) -> Option<EyeRun<'a>> {
+    pub(crate) fn eye_run<'a, const N: usize>(
+        &self,
+        eye: &'a EyeGrid,
+        ends: [Vec3; N],
+    ) -> Option<EyeRun<'a>> {
+        let area = self.eye_area(eye, ends)?;
+        Some(eye.run(area))
+    }
+
+    /// Where every direction from the eye among `ends` (any length: the directions of
+    /// one image row between two pixels, or the corners of a pixel's square) falls in
+    /// the eye grid: in one cell when the ends do (a cell is a square in its face's
+    /// plane, and the directions among the ends project to the segment or the
+    /// quadrilateral they span, inside it; cells list every sphere seen within a
+    /// widened cone, which covers the rounding of the directions many times over) and
+    /// the eye is inside no sphere; in the sky when the ends fall in cells of one face
+    /// and no cell among them lists a sphere. `None` otherwise.
+    #[inline]
+    pub(crate) fn eye_area<const N: usize>(
+        &self,
+        eye: &EyeGrid,
+        ends: [Vec3; N],
+    ) -> Option<EyeArea> {
         let grid = eye.shortcut(self.len())?;
-        let (at_a, at_b) = (grid.place(a), grid.place(b));
-        if at_a == at_b {
-            return Some(EyeRun::of_cell(grid, grid.cell_at(at_a)));
+        let places = ends.map(|d| grid.place(d));
+        if places.iter().all(|&p| p == places[0]) {
+            return Some(EyeArea::Cell(grid.cell_at(places[0]) as u32));
         }
         // Across cells, the run is sky if none of them lists a sphere: in a large
         // scene a cell is narrower than a run, and the sky above the balls is many
         // runs.
-        grid.lists_nothing_between(at_a, at_b)
-            .then_some(EyeRun { candidates: &[] })
+        grid.lists_nothing_among(&places).then_some(EyeArea::Sky)
     }
 
     #[inline(always)]
@@ -450,7 +488,7 @@ impl Spheres {
     /// itself, [`EyeRun::sees_nothing`]; the tests ask this.)
     #[cfg(test)]
     pub(crate) fn eye_sees_nothing_between(&self, eye: &EyeGrid, a: Vec3, b: Vec3) -> bool {
-        self.eye_run(eye, a, b)
+        self.eye_run(eye, [a, b])
             .is_some_and(|run| run.sees_nothing())
     }
 

@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
 
 use super::bands::for_each_row;
-use super::film::each_sample;
+use super::film::{each_sample, Film};
 use super::resolve::pixel_value;
 use super::{Frame, RenderControl, RenderError, Traced};
 use crate::sampling::sample_offset;
@@ -62,6 +62,7 @@ pub(super) fn adaptive<T: SampleTracer>(
     let area = settings.area();
     let first = first_pass_samples(spp, a.first, settings.seed);
     let nf = first.len();
+    let film = Film::new(settings);
 
     // The first pass covers the area and a one-pixel margin inside the image, so a
     // region's edge pixels see the same neighbours as in the whole image.
@@ -156,7 +157,7 @@ pub(super) fn adaptive<T: SampleTracer>(
                 let mut slots = p.iter_mut();
                 each_sample(
                     tracer,
-                    settings,
+                    &film,
                     (i, j),
                     first.iter().copied(),
                     counts,
@@ -221,7 +222,7 @@ pub(super) fn adaptive<T: SampleTracer>(
             };
             let rest = (0..spp).filter(|k| first.binary_search(k).is_err());
             let mut next = 0;
-            each_sample(tracer, settings, (i, j), rest, counts, |k, v| {
+            each_sample(tracer, &film, (i, j), rest, counts, |k, v| {
                 while next < nf && first[next] < k {
                     add(stored[next]);
                     next += 1;

@@ -29,7 +29,7 @@ use crate::trace::reference::ReferenceTracer;
 use crate::trace::{RayCounts, SampleTracer};
 use adaptive::adaptive;
 use bands::{for_each_pixel, for_each_row, for_each_row_of_bytes, in_pool, BAND_ROWS};
-use film::{centre_height, each_sample, pixel_centres};
+use film::{centre_height, each_sample, pixel_centres, Film};
 
 pub use adaptive::first_pass_samples;
 use frame::bytes_of_row;
@@ -384,6 +384,7 @@ fn render_with<T: SampleTracer>(
 ) -> Result<Traced, RenderError> {
     let area = settings.area();
     let spp = settings.quality.spp;
+    let film = Film::new(settings);
     let n = area.width as usize * area.height as usize;
     control.set_samples_total(n as u64 * u64::from(spp));
     let frame = |pixels| Frame {
@@ -424,7 +425,7 @@ fn render_with<T: SampleTracer>(
                     for (a, p) in row.iter_mut().enumerate() {
                         let i = area.x + a as u32;
                         let mut sum = Vec3::ZERO;
-                        each_sample(tracer, settings, (i, j), 0..spp, counts, |_, (c, _)| {
+                        each_sample(tracer, &film, (i, j), 0..spp, counts, |_, (c, _)| {
                             sum += c;
                         });
                         *p = pixel_value(sum, spp);
@@ -449,7 +450,7 @@ fn render_with<T: SampleTracer>(
                 u64::from(spp),
                 control,
                 |i, j, (sum, bound), counts| {
-                    each_sample(tracer, settings, (i, j), 0..spp, counts, |_, (c, b)| {
+                    each_sample(tracer, &film, (i, j), 0..spp, counts, |_, (c, b)| {
                         *sum += c;
                         *bound += b;
                     });

@@ -7,10 +7,10 @@ use std::ops::Range;
 use glam::Vec3;
 
 use super::bands::{for_each_pixel, for_each_row};
-use super::film::{centre_height, centres_of, each_sample, film, in_pairs};
+use super::film::{centre_height, centres_of, each_sample, Film};
 use super::{RenderControl, RenderError};
 use crate::settings::Settings;
-use crate::trace::{RayCounts, SampleTracer};
+use crate::trace::{in_pairs, RayCounts, SampleTracer};
 
 /// Sample 0 of the pixels `columns` (film abscissae `centres`, from [`centres_of`]) of
 /// row `j` into `out`, as [`accumulate`] of sample 0 sums it: the pixel centres a row
@@ -29,10 +29,11 @@ pub(crate) fn first_samples<T: SampleTracer + ?Sized>(
         return;
     }
     // Two pixels at a time, each sum from zero as `accumulate` starts it.
+    let film = Film::new(settings);
     let at = columns
         .iter()
         .zip(out)
-        .map(|(&i, sum)| (sum, film(settings, i, j, 0)));
+        .map(|(&i, sum)| (sum, film.at(i, j, 0)));
     in_pairs(tracer, at, counts, |sum, (c, _)| {
         *sum = Vec3::ZERO;
         *sum += c;
@@ -56,13 +57,14 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
     }
     let n = samples.len() as u64;
     let afresh = samples.start == 0;
+    let film = Film::new(settings);
     for_each_pixel(settings, area, sums, n, control, |i, j, sum, counts| {
         if afresh {
             *sum = Vec3::ZERO;
         }
         each_sample(
             tracer,
-            settings,
+            &film,
             (i, j),
             samples.clone(),
             counts,

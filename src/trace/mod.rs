@@ -33,6 +33,16 @@ impl RayCounts {
     }
 }
 
+/// A rectangle of the film, `[s[0], s[1]] × [t[0], t[1]]` (`t` from the bottom): the
+/// square of one pixel, which all its samples lie in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilmRect {
+    /// The least and the greatest abscissa.
+    pub s: [f32; 2],
+    /// The least and the greatest height.
+    pub t: [f32; 2],
+}
+
 /// Something that computes the linear RGB of one sample.
 pub trait SampleTracer: Sync {
     /// The colour of the ray through film position `(s, t)` ∈ \[0, 1\]² (`t` from the bottom).
@@ -57,6 +67,20 @@ pub trait SampleTracer: Sync {
         one_by_one(self, s, t, counts)
     }
 
+    /// `out[n] = sample_bounded(at[n].0, at[n].1)` for film positions `at` that all lie
+    /// in `area` (the samples of one pixel): the same values as one by one (a tracer
+    /// may share work between the samples of one small area).
+    fn sample_bounded_in(
+        &self,
+        area: FilmRect,
+        at: &[(f32, f32)],
+        out: &mut [(Vec3, f32)],
+        counts: &mut RayCounts,
+    ) {
+        let _ = area;
+        slice_in_pairs(self, at, out, counts);
+    }
+
     /// `out[i] = sample(s[i], t)`: a row of samples at one height, the same colours
     /// as one by one (a tracer may share work between neighbours).
     fn sample_row(&self, s: &[f32], t: f32, out: &mut [Vec3], counts: &mut RayCounts) {
@@ -75,4 +99,38 @@ pub(crate) fn one_by_one<T: SampleTracer + ?Sized>(
 ) -> [(Vec3, f32); 2] {
     let first = tracer.sample_bounded(s[0], t[0], counts);
     [first, tracer.sample_bounded(s[1], t[1], counts)]
+}
+
+/// Each film position of `at` traced, in order, its (colour, cutoff bound) given to
+/// `each` with its tag: two at a time through [`SampleTracer::sample_bounded_pair`],
+/// the same values as one by one.
+#[inline]
+pub(crate) fn in_pairs<T: SampleTracer + ?Sized, Tag>(
+    tracer: &T,
+    at: impl IntoIterator<Item = (Tag, (f32, f32))>,
+    counts: &mut RayCounts,
+    mut each: impl FnMut(Tag, (Vec3, f32)),
+) {
+    let mut at = at.into_iter();
+    while let Some((tag, (s, t))) = at.next() {
+        match at.next() {
+            Some((next, (s_next, t_next))) => {
+                let [a, b] = tracer.sample_bounded_pair([s, s_next], [t, t_next], counts);
+                each(tag, a);
+                each(next, b);
+            }
+            None => each(tag, tracer.sample_bounded(s, t, counts)),
+        }
+    }
+}
+
+/// `out[n] = sample_bounded(at[n].0, at[n].1)`, two at a time ([`in_pairs`]).
+pub(crate) fn slice_in_pairs<T: SampleTracer + ?Sized>(
+    tracer: &T,
+    at: &[(f32, f32)],
+    out: &mut [(Vec3, f32)],
+    counts: &mut RayCounts,
+) {
+    let at = out.iter_mut().zip(at.iter().copied());
+    in_pairs(tracer, at, counts, |out, value| *out = value);
 }

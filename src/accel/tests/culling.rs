@@ -11,7 +11,7 @@ use glam::DVec3;
 use proptest::prelude::*;
 
 use super::*;
-use crate::accel::{Hit, InsideLists, Spheres};
+use crate::accel::{EyeArea, Hit, InsideLists, Spheres};
 use crate::scene::Sphere;
 
 /// Random spheres: radius 10^U(−3,3), centre 10^U(−1,4) from the origin.
@@ -444,7 +444,7 @@ fn rows_in_one_cell_get_the_per_ray_hits() {
                     let h = across.cross(base).normalize_or(across) * span;
                     let (corner, h) = ((base - h * 0.5).as_vec3(), h.as_vec3());
                     let dir = |s: f32| (corner + h * s).normalize();
-                    let Some(run) = set.eye_run(&grid, dir(0.0), dir(1.0)) else {
+                    let Some(run) = set.eye_run(&grid, [dir(0.0), dir(1.0)]) else {
                         continue;
                     };
                     c.0 += 1;
@@ -472,6 +472,128 @@ fn rows_in_one_cell_get_the_per_ray_hits() {
     assert!(
         runs > 500 && hits > 2000,
         "too few to say anything: {runs} runs, {hits} hits"
+    );
+}
+
+/// The tracer's pixel squares: when `eye_area` says the directions through a
+/// parallelogram of the film (corner + s·h + t·v, s and t in [0, 1], its corners given
+/// unnormalised, as the tracer gives a pixel's) fall in one cell, the query of each
+/// direction with that cell's spheres gives the per-ray query's hit to the bit; when it
+/// says they see the sky, brute force in `f64` finds no sphere along any of them.
+#[test]
+fn pixel_squares_in_one_cell_or_the_sky_get_the_per_ray_hits() {
+    // (squares in one cell, squares of sky, directions checked, hits, squares whose
+    // last corner alone leaves the others' cell)
+    let counts = RefCell::new((0u64, 0u64, 0u64, 0u64, 0u64));
+    let squares = prop::collection::vec(
+        (
+            0.0f64..1.0,
+            unit_vector(),
+            log_uniform(-4.0, -1.5),
+            0.3f64..3.0,
+        ),
+        24,
+    );
+    runner(150)
+        .run(
+            &(
+                world(),
+                any::<bool>(),
+                log_uniform(-1.0, 4.0),
+                unit_vector(),
+                squares,
+            ),
+            |(spheres, few, eye_dist, eye_dir, squares)| {
+                // Few spheres in half the worlds, so that empty cells are common.
+                let spheres = &spheres[..spheres.len().min(if few { 12 } else { usize::MAX })];
+                let eye = eye_dir * eye_dist;
+                let set = Spheres::new(spheres);
+                let grid = set.eye_grid(eye, None);
+                let mut c = counts.borrow_mut();
+                for &(pick, across, span, aspect) in &squares {
+                    // A square through a random sphere, or (a third of them) towards
+                    // anywhere, tilted at random.
+                    let s =
+                        &spheres[((pick * spheres.len() as f64) as usize).min(spheres.len() - 1)];
+                    let base = if pick < 0.33 {
+                        across.any_orthonormal_vector()
+                    } else {
+                        (s.center - eye).normalize_or(across)
+                    };
+                    let h = across.cross(base).normalize_or(across) * span;
+                    let v = base.cross(h).normalize_or(across) * (span * aspect);
+                    let (corner, h, v) =
+                        ((base - (h + v) * 0.5).as_vec3(), h.as_vec3(), v.as_vec3());
+                    let toward = |s: f32, t: f32| (corner + h * s) + v * t;
+                    let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
+                    // One cell exactly when all four corners fall in it (this square
+                    // and larger ones about it).
+                    if let Some(g) = grid.shortcut(spheres.len()) {
+                        for grow in [1.0, 3.0, 9.0, 27.0, 81.0] {
+                            let centre = corner + (h + v) * 0.5;
+                            let at =
+                                |s: f32, t: f32| centre + (h * (s - 0.5) + v * (t - 0.5)) * grow;
+                            let ends = corners.map(|(s, t)| at(s, t));
+                            let places = ends.map(|d| g.place(d));
+                            let one_cell = places.iter().all(|&p| p == places[0]);
+                            let cell = Some(EyeArea::Cell(g.cell_at(places[0]) as u32));
+                            prop_assert_eq!(one_cell, set.eye_area(&grid, ends) == cell);
+                            let last_out = places[..3].iter().all(|&p| p == places[0]);
+                            c.4 += u64::from(!one_cell && last_out);
+                        }
+                    }
+                    let area = set.eye_area(&grid, corners.map(|(s, t)| toward(s, t)));
+                    let Some(area) = area else {
+                        continue;
+                    };
+                    let run = grid.run(area);
+                    if run.sees_nothing() {
+                        c.1 += 1;
+                    } else {
+                        c.0 += 1;
+                    }
+                    // A 7 × 7 lattice over the square, its edges and corners included.
+                    for step in 0..49 {
+                        let (s, t) = ((step % 7) as f32 / 6.0, (step / 7) as f32 / 6.0);
+                        let (a, b) = (toward(s, t).normalize(), toward(1.0 - s, t).normalize());
+                        c.2 += 2;
+                        let shared = set.closest_in_run_pair(&grid, &run, a, b);
+                        for (d, got) in [(a, shared[0]), (b, shared[1])] {
+                            let alone = set.closest_from_eye(&grid, d);
+                            let key = |h: Option<Hit>| {
+                                h.map(|h| (h.sphere, h.point, h.normal, h.entering))
+                            };
+                            prop_assert_eq!(key(got), key(alone));
+                            c.3 += u64::from(got.is_some());
+                            if run.sees_nothing() {
+                                let q = Query {
+                                    origin: eye,
+                                    dir: d,
+                                    from: None,
+                                };
+                                let (o, d64) = query_ray(&q);
+                                let hits: Vec<_> = crossings(o, d64, spheres, None, 0.0)
+                                    .into_iter()
+                                    .filter(|x| !x.3)
+                                    .collect();
+                                prop_assert!(hits.is_empty(), "a square of sky hits {hits:?}");
+                            }
+                        }
+                    }
+                }
+                Ok(())
+            },
+        )
+        .unwrap_or_else(|e| panic!("{e}\n{:?}", counts.borrow()));
+    let (cells, sky, checked, hits, last_out) = counts.into_inner();
+    println!(
+        "pixel squares: {cells} in one cell, {sky} of sky, {checked} directions, {hits} hits, \
+         {last_out} left by the last corner alone"
+    );
+    assert!(
+        cells > 500 && sky > 100 && hits > 2000 && last_out > 20,
+        "too few to say anything: {cells} in one cell, {sky} of sky, {hits} hits, \
+         {last_out} left by the last corner alone"
     );
 }
 
@@ -808,7 +930,7 @@ fn a_crowded_eye_and_light_walk_the_hierarchy_and_lose_nothing() {
             dir,
             from: None,
         };
-        assert!(set.eye_run(&eye_grid, dir, dir).is_none());
+        assert!(set.eye_run(&eye_grid, [dir, dir]).is_none());
         let (o, d) = query_ray(&q);
         let all = crossings(o, d, &spheres, None, 0.0);
         let mut sorted: Vec<_> = all.iter().filter(|x| !x.1.is_nan()).collect();
