@@ -7,7 +7,7 @@
 
 use std::cell::RefCell;
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use proptest::prelude::*;
 
 use super::*;
@@ -80,6 +80,25 @@ fn crossings(
         }
     }
     out
+}
+
+/// The spheres that brute force in `f64` sees clearly crossed by the primary ray from
+/// `eye` in direction `d` (none too close to call).
+fn clearly_crossed(eye: DVec3, d: Vec3, spheres: &[Sphere]) -> Vec<(usize, f64, DVec3, bool)> {
+    let (o, d64) = query_ray(&Query {
+        origin: eye,
+        dir: d,
+        from: None,
+    });
+    crossings(o, d64, spheres, None, 0.0)
+        .into_iter()
+        .filter(|x| !x.3)
+        .collect()
+}
+
+/// What of a hit the shared queries must give as the per-ray one does.
+fn hit_key(hit: Option<Hit>) -> Option<(u32, DVec3, DVec3, bool)> {
+    hit.map(|h| (h.sphere, h.point, h.normal, h.entering))
 }
 
 /// The shadow ray from `hit` towards `light`, its length, and the shadow factor that
@@ -394,16 +413,7 @@ fn sky_runs_see_no_sphere() {
                     for step in 0..=16 {
                         let d = dir(step as f32 / 16.0);
                         c.2 += 1;
-                        let q = Query {
-                            origin: eye,
-                            dir: d,
-                            from: None,
-                        };
-                        let (o, d64) = query_ray(&q);
-                        let hits: Vec<_> = crossings(o, d64, spheres, None, 0.0)
-                            .into_iter()
-                            .filter(|x| !x.3)
-                            .collect();
+                        let hits = clearly_crossed(eye, d, spheres);
                         prop_assert!(hits.is_empty(), "a sky run hits {hits:?}");
                         prop_assert!(set.closest_from_eye(&grid, d).is_none());
                     }
@@ -454,10 +464,7 @@ fn rows_in_one_cell_get_the_per_ray_hits() {
                         let shared = set.closest_in_run_pair(&grid, &run, a, b);
                         for (d, got) in [(a, shared[0]), (b, shared[1])] {
                             let alone = set.closest_from_eye(&grid, d);
-                            let key = |h: Option<Hit>| {
-                                h.map(|h| (h.sphere, h.point, h.normal, h.entering))
-                            };
-                            prop_assert_eq!(key(got), key(alone));
+                            prop_assert_eq!(hit_key(got), hit_key(alone));
                             c.2 += u64::from(got.is_some());
                             prop_assert!(!run.sees_nothing() || got.is_none());
                         }
@@ -560,22 +567,10 @@ fn pixel_squares_in_one_cell_or_the_sky_get_the_per_ray_hits() {
                         let shared = set.closest_in_run_pair(&grid, &run, a, b);
                         for (d, got) in [(a, shared[0]), (b, shared[1])] {
                             let alone = set.closest_from_eye(&grid, d);
-                            let key = |h: Option<Hit>| {
-                                h.map(|h| (h.sphere, h.point, h.normal, h.entering))
-                            };
-                            prop_assert_eq!(key(got), key(alone));
+                            prop_assert_eq!(hit_key(got), hit_key(alone));
                             c.3 += u64::from(got.is_some());
                             if run.sees_nothing() {
-                                let q = Query {
-                                    origin: eye,
-                                    dir: d,
-                                    from: None,
-                                };
-                                let (o, d64) = query_ray(&q);
-                                let hits: Vec<_> = crossings(o, d64, spheres, None, 0.0)
-                                    .into_iter()
-                                    .filter(|x| !x.3)
-                                    .collect();
+                                let hits = clearly_crossed(eye, d, spheres);
                                 prop_assert!(hits.is_empty(), "a square of sky hits {hits:?}");
                             }
                         }
