@@ -22,7 +22,7 @@ const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 /// The offset in `[0,1)²` of sample `k` of `spp` in pixel `(i, j)`.
 #[inline]
 pub fn sample_offset(i: u32, j: u32, k: u32, spp: u32, seed: u64) -> (f32, f32) {
-    Strata::new(spp).offset(i, j, k, seed)
+    Strata::new(spp).of_pixel(i, j, seed).offset(k)
 }
 
 /// The cells that stratify a pixel's samples ([`sample_offset`]), worked out once for
@@ -43,12 +43,6 @@ impl Strata {
             nx,
             ny: spp.max(1).div_ceil(nx),
         }
-    }
-
-    /// [`sample_offset`] of sample `k` of pixel `(i, j)`.
-    #[inline]
-    pub(crate) fn offset(&self, i: u32, j: u32, k: u32, seed: u64) -> (f32, f32) {
-        self.of_pixel(i, j, seed).offset(k)
     }
 
     /// What the samples of pixel `(i, j)` share: where their cells start.
