@@ -121,9 +121,10 @@ fn cutoff_skips_work_and_reports_a_nonzero_bound_on_hw3() {
 }
 
 /// `SampleTracer::sample_row` gives the colours `sample` gives one by one, and casts the
-/// same rays, whatever the cutoff: the fast tracer shares work along a row only where
-/// nothing is skipped. At ε = 1.5 every branch is skipped (a primary hit's weights are
-/// at most 1), so every pixel but the sky's is black.
+/// same rays, whatever the cutoff: the fast tracer shares work along a row with a
+/// cutoff too, where it shades each hit as `sample` does. At ε = 1.5 every branch is
+/// skipped (a primary hit's weights are at most 1), so every pixel but the sky's is
+/// black.
 #[test]
 fn a_row_of_samples_is_its_samples_one_by_one_at_any_cutoff() {
     let (scene, mut opts) = hw3_opts(96, 54, 1);

@@ -28,7 +28,7 @@ use crate::trace::fast::FastTracer;
 use crate::trace::reference::ReferenceTracer;
 use crate::trace::{RayCounts, SampleTracer};
 use adaptive::adaptive;
-use bands::{for_each_pixel, for_each_row, for_each_row_of_bytes, in_pool, BAND_ROWS};
+use bands::{for_each_row, for_each_row_of_bytes, in_pool, BAND_ROWS};
 use film::{centre_height, each_sample, pixel_centres, Film};
 
 pub use adaptive::first_pass_samples;
@@ -443,17 +443,27 @@ fn render_with<T: SampleTracer>(
             let mut acc: Vec<(Vec3, f32)> = in_pool(settings, || {
                 (0..n).into_par_iter().map(|_| (Vec3::ZERO, 0.0)).collect()
             })?;
-            let rays = for_each_pixel(
+            let centres = pixel_centres(settings, area);
+            let rays = for_each_row(
                 settings,
                 area,
                 &mut acc,
+                1,
                 u64::from(spp),
                 control,
-                |i, j, (sum, bound), counts| {
-                    each_sample(tracer, &film, (i, j), 0..spp, counts, |_, (c, b)| {
-                        *sum += c;
-                        *bound += b;
-                    });
+                |j, row, counts| {
+                    if spp == 1 {
+                        // The pixel centres a row at a time, as without a cutoff.
+                        let t = centre_height(settings, j);
+                        return tracer.sample_row_bounded(&centres, t, row, counts);
+                    }
+                    for (a, (sum, bound)) in row.iter_mut().enumerate() {
+                        let i = area.x + a as u32;
+                        each_sample(tracer, &film, (i, j), 0..spp, counts, |_, (c, b)| {
+                            *sum += c;
+                            *bound += b;
+                        });
+                    }
                 },
             )?;
             let (pixels, bounds) = in_pool(settings, || {

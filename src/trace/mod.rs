@@ -88,6 +88,20 @@ pub trait SampleTracer: Sync {
             *o = self.sample(s, t, counts);
         }
     }
+
+    /// `out[i] = sample_bounded(s[i], t)`: [`SampleTracer::sample_row`] with each
+    /// sample's bound.
+    fn sample_row_bounded(
+        &self,
+        s: &[f32],
+        t: f32,
+        out: &mut [(Vec3, f32)],
+        counts: &mut RayCounts,
+    ) {
+        for (o, &s) in out.iter_mut().zip(s) {
+            *o = self.sample_bounded(s, t, counts);
+        }
+    }
 }
 
 /// [`SampleTracer::sample_bounded_pair`] as two samples, one after the other.
