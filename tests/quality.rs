@@ -120,37 +120,60 @@ fn cutoff_skips_work_and_reports_a_nonzero_bound_on_hw3() {
     assert_ne!(cut.frame, exact.frame);
 }
 
-/// `SampleTracer::sample_row` gives the colours `sample` gives one by one, and casts the
-/// same rays, whatever the cutoff: the fast tracer shares work along a row with a
-/// cutoff too, where it shades each hit as `sample` does. At ε = 1.5 every branch is
-/// skipped (a primary hit's weights are at most 1), so every pixel but the sky's is
-/// black.
+/// `SampleTracer::sample_row` gives the colours `sample` gives one by one, and
+/// `sample_row_bounded` what `sample_bounded` gives (colour and bound), each casting the
+/// same rays, whatever the cutoff, with both tracers: the fast tracer shares work along
+/// a row with a cutoff too, where it shades each hit as `sample` does; the reference
+/// tracer takes the trait's rows. At ε = 1.5 the fast tracer skips every branch (a
+/// primary hit's weights are at most 1), so every pixel but the sky's is black; the
+/// reference tracer has no cutoff.
 #[test]
 fn a_row_of_samples_is_its_samples_one_by_one_at_any_cutoff() {
     let (scene, mut opts) = hw3_opts(96, 54, 1);
     let s: Vec<f32> = (0..96).map(|i| (i as f32 + 0.5) / 96.0).collect();
-    for cutoff in [0.0, 0.05, 0.25, 1.5] {
+    for (precision, cutoff) in [
+        (Precision::Fast, 0.0),
+        (Precision::Fast, 0.05),
+        (Precision::Fast, 0.25),
+        (Precision::Fast, 1.5),
+        (Precision::Reference, 0.05),
+    ] {
         opts.quality.cutoff = cutoff;
+        opts.quality.precision = precision;
         let tracer = make_tracer(&scene, &opts).unwrap();
-        let mut black = 0;
+        let (mut black, mut bounded) = (0, 0);
         for j in 0..54 {
             let t = (j as f32 + 0.5) / 54.0;
             let (mut row, mut row_rays) = (vec![Vec3::NAN; 96], Default::default());
             tracer.sample_row(&s, t, &mut row, &mut row_rays);
+            let (mut with_bounds, mut bounded_rays) =
+                (vec![(Vec3::NAN, f32::NAN); 96], Default::default());
+            tracer.sample_row_bounded(&s, t, &mut with_bounds, &mut bounded_rays);
             let mut one_by_one_rays = Default::default();
-            let one_by_one: Vec<Vec3> = s
+            let one_by_one: Vec<(Vec3, f32)> = s
                 .iter()
-                .map(|&s| tracer.sample(s, t, &mut one_by_one_rays))
+                .map(|&s| tracer.sample_bounded(s, t, &mut one_by_one_rays))
                 .collect();
-            assert_eq!(row, one_by_one, "ε {cutoff}, row {j}");
-            assert_eq!(row_rays, one_by_one_rays, "ε {cutoff}, row {j}");
+            let colours: Vec<Vec3> = one_by_one.iter().map(|p| p.0).collect();
+            let at = format!("{precision:?}, ε {cutoff}, row {j}");
+            assert_eq!(row, colours, "{at}");
+            assert_eq!(with_bounds, one_by_one, "{at}");
+            assert_eq!(row_rays, one_by_one_rays, "{at}");
+            assert_eq!(bounded_rays, one_by_one_rays, "{at}");
             black += row.iter().filter(|c| **c == Vec3::ZERO).count();
+            bounded += one_by_one.iter().filter(|p| p.1 > 0.0).count();
         }
+        let skips = precision == Precision::Fast && cutoff > 0.0;
+        assert_eq!(
+            bounded > 0,
+            skips,
+            "{precision:?}, ε {cutoff}: {bounded} bounded"
+        );
         // hw3's view is about half ground and balls.
         assert_eq!(
             black > 96 * 54 / 4,
-            cutoff > 1.0,
-            "ε {cutoff}: {black} black"
+            skips && cutoff > 1.0,
+            "{precision:?}, ε {cutoff}: {black} black"
         );
     }
 }

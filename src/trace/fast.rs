@@ -783,8 +783,8 @@ mod tests {
     /// Two samples at once give what each gives alone, to the bit, with the same ray
     /// counts: pairs of film positions near each other (as a pixel's samples) and far
     /// apart, on hw3 (through the eye's grid), on 70,000 balls (no grid: the
-    /// hierarchy), with a contribution cutoff (each sample alone, with its bound), and
-    /// at depth 0 (every sample the sky).
+    /// hierarchy), under contribution cutoffs (with each sample's bound; 1.5 skips even
+    /// a primary hit's local term), and at depth 0 (every sample the sky).
     #[test]
     fn a_pair_of_samples_is_each_sample_alone() {
         let hw3 = hw3_scene(HW3_DEFAULT_SEED);
@@ -849,7 +849,7 @@ mod tests {
     /// alone, to the bit, with the same ray counts: 1 to 16 samples at random in
     /// random pixels (and at the pixels' corners) of hw3 at 1280×720 and 64×36 (most
     /// squares in one cell of the eye grid or in the sky; many across cells), of
-    /// 70,000 balls (no grid), with a cutoff, and at depth 0.
+    /// 70,000 balls (no grid), under cutoffs (0.05, 0.2, 1.5), and at depth 0.
     #[test]
     fn a_pixel_s_samples_are_each_sample_alone() {
         let hw3 = hw3_scene(HW3_DEFAULT_SEED);
