@@ -611,7 +611,7 @@ impl SampleTracer for FastTracer {
     }
 
     /// Two samples' primary rays through the eye's query as a pair, their hits shaded
-    /// as a pair ([`FastTracer::pair`]).
+    /// as a pair (`FastTracer::pair`).
     fn sample_bounded_pair(
         &self,
         s: [f32; 2],
@@ -628,7 +628,7 @@ impl SampleTracer for FastTracer {
     }
 
     /// The area's corners looked up in the eye grid once for all its samples
-    /// ([`FastTracer::samples_in`]); under a contribution cutoff, the samples in pairs.
+    /// (`FastTracer::samples_in`); under a contribution cutoff, the samples in pairs.
     fn sample_bounded_in(
         &self,
         area: FilmRect,
