@@ -967,6 +967,8 @@ transmit = {transmit}
 ///   transmitted), one shadow ray (p's).
 /// - ε = 0.3 keeps only p's transmitted branch, whose three branches at q are all
 ///   skipped: colour 0, bound ¼ + ¼ + ⅛ + ⅛ + ¼ = 1; one primary and one secondary ray.
+/// - The same under a light of intensity 2: the largest value a trace returns is 2, so
+///   the bound is 2 (the colour still 0).
 #[test]
 fn the_cutoff_skips_branches_below_it_by_hand() {
     let toml = one_pixel(
@@ -1015,6 +1017,17 @@ ior = 1
         assert_eq!(cut.cutoff_bound, [bound], "ε {cutoff}");
         assert_eq!(cut.stats.rays, rays, "ε {cutoff}");
     }
+    let bright = scene_of(&toml.replace(
+        "position = [0, 0, 10]",
+        "position = [0, 0, 10]\nintensity = [2, 2, 2]",
+    ));
+    let mut opts = bright.settings();
+    opts.quality.cutoff = 0.3;
+    let cut = render::render_bounded(&bright, &opts, &RenderControl::default()).unwrap();
+    assert_eq!(
+        (cut.frame.get(0, 0), cut.cutoff_bound),
+        (Vec3::ZERO, vec![2.0])
+    );
 }
 
 /// A light in the plane tangent to the hit point (n·L = 0 exactly) adds nothing and

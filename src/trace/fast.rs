@@ -562,15 +562,16 @@ impl FastTracer {
                 }
             } else {
                 // Two rays at a time through the eye query (see
-                // `Spheres::closest_from_eye_pair`), then shaded one by one, as `trace`.
+                // `Spheres::closest_from_eye_pair`), their hits shaded as a pair.
                 let bounds = bounds.next().unwrap_or_default();
                 self.shade_run::<SKIPS>(dirs, out, bounds, counts, hits);
             }
         }
     }
 
-    /// [`FastTracer::row`] under a contribution cutoff, a run of at most [`RUN`]
-    /// samples at a time (out of line, as [`FastTracer::pair_skipping`]).
+    /// [`FastTracer::row`] under a contribution cutoff (out of line, as
+    /// [`FastTracer::pair_skipping`]); its callers hand it a run of at most [`RUN`]
+    /// samples at a time, their bounds in an array on the stack.
     #[inline(never)]
     fn row_skipping(
         &self,
