@@ -471,54 +471,6 @@ impl FastTracer {
         self.pair::<true>(s, t, counts)
     }
 
-    /// [`SampleTracer::sample_bounded_in`] without a contribution cutoff: the area's
-    /// corners looked up in the eye grid once for all its samples
-    /// (`Spheres::eye_area`); when they fall in one cell, each pair of samples reads
-    /// that cell's spheres without a lookup of its own; in cells of one face that list
-    /// nothing, every sample sees the sky, without a query.
-    #[inline(always)]
-    fn samples_in(
-        &self,
-        area: FilmRect,
-        at: &[(f32, f32)],
-        out: &mut [(Vec3, f32)],
-        counts: &mut RayCounts,
-    ) {
-        // Four lookups for the corners pay from four samples on.
-        let shared = (self.max_depth > 0 && at.len() >= 4)
-            .then(|| self.eye_area_of(area))
-            .flatten();
-        let Some(shared) = shared else {
-            return super::slice_in_pairs(self, at, out, counts);
-        };
-        let dir = |(s, t): (f32, f32)| {
-            model::primary_direction(self.corner, self.horizontal, self.vertical, s, t)
-        };
-        let run = self.eye.run(shared);
-        let (mut dirs, mut colours) = ([Vec3::ZERO; RUN], [Vec3::ZERO; RUN]);
-        for (at, out) in at.chunks(RUN).zip(out.chunks_mut(RUN)) {
-            let n = at.len();
-            for (d, &p) in dirs.iter_mut().zip(at) {
-                *d = dir(p);
-            }
-            let colours = &mut colours[..n];
-            if run.sees_nothing() {
-                row::sky(&dirs, self.compiled.sky_down, self.compiled.sky_up, colours);
-                counts.primary += n as u64;
-            } else {
-                self.shade_run::<false>(&dirs[..n], colours, &mut [], counts, |a, b| {
-                    self.compiled
-                        .spheres
-                        .closest_in_run_pair(&self.eye, &run, a, b)
-                });
-            }
-            // No cutoff: nothing is skipped, so each bound is `sample_bounded`'s, zero.
-            for (o, &c) in out.iter_mut().zip(&*colours) {
-                *o = (c, 0.0);
-            }
-        }
-    }
-
     /// [`SampleTracer::sample_row`] for a tracer that traces rays (depth above 0):
     /// runs of a few samples whose end directions fall in one cell of the eye grid
     /// share that cell's spheres (`Spheres::eye_run`): an empty cell means sky, as
@@ -629,7 +581,11 @@ impl SampleTracer for FastTracer {
     }
 
     /// The area's corners looked up in the eye grid once for all its samples
-    /// (`FastTracer::samples_in`); under a contribution cutoff, the samples in pairs.
+    /// (`Spheres::eye_area`): when they fall in one cell, each pair of samples reads
+    /// that cell's spheres without a lookup of its own; in cells of one face that list
+    /// nothing, every sample sees the sky, without a query. Under a contribution
+    /// cutoff, the samples in pairs (`sample_bounded_pair`): a second copy of the
+    /// area's path changed how the compiler inlines the first.
     fn sample_bounded_in(
         &self,
         area: FilmRect,
@@ -637,12 +593,39 @@ impl SampleTracer for FastTracer {
         out: &mut [(Vec3, f32)],
         counts: &mut RayCounts,
     ) {
-        if self.cutoff != 0.0 {
-            // In pairs (`sample_bounded_pair`): a second copy of the area's path
-            // changed how the compiler inlines the first.
+        // Four lookups for the corners pay from four samples on.
+        let shared = (self.cutoff == 0.0 && self.max_depth > 0 && at.len() >= 4)
+            .then(|| self.eye_area_of(area))
+            .flatten();
+        let Some(shared) = shared else {
             return super::slice_in_pairs(self, at, out, counts);
+        };
+        let dir = |(s, t): (f32, f32)| {
+            model::primary_direction(self.corner, self.horizontal, self.vertical, s, t)
+        };
+        let run = self.eye.run(shared);
+        let (mut dirs, mut colours) = ([Vec3::ZERO; RUN], [Vec3::ZERO; RUN]);
+        for (at, out) in at.chunks(RUN).zip(out.chunks_mut(RUN)) {
+            let n = at.len();
+            for (d, &p) in dirs.iter_mut().zip(at) {
+                *d = dir(p);
+            }
+            let colours = &mut colours[..n];
+            if run.sees_nothing() {
+                row::sky(&dirs, self.compiled.sky_down, self.compiled.sky_up, colours);
+                counts.primary += n as u64;
+            } else {
+                self.shade_run::<false>(&dirs[..n], colours, &mut [], counts, |a, b| {
+                    self.compiled
+                        .spheres
+                        .closest_in_run_pair(&self.eye, &run, a, b)
+                });
+            }
+            // No cutoff: nothing is skipped, so each bound is `sample_bounded`'s, zero.
+            for (o, &c) in out.iter_mut().zip(&*colours) {
+                *o = (c, 0.0);
+            }
         }
-        self.samples_in(area, at, out, counts);
     }
 
     fn sample_row(&self, s: &[f32], t: f32, out: &mut [Vec3], counts: &mut RayCounts) {
@@ -671,19 +654,13 @@ impl SampleTracer for FastTracer {
         out: &mut [(Vec3, f32)],
         counts: &mut RayCounts,
     ) {
-        if self.max_depth == 0 {
-            for (o, &s) in out.iter_mut().zip(s) {
-                *o = self.sample_bounded(s, t, counts);
-            }
-            return;
-        }
         let (mut colours, mut bounds) = ([Vec3::ZERO; RUN], [0.0; RUN]);
         for (s, out) in s.chunks(RUN).zip(out.chunks_mut(RUN)) {
             let n = s.len();
-            if self.cutoff != 0.0 {
+            if self.cutoff != 0.0 && self.max_depth > 0 {
                 self.row_skipping(s, t, &mut colours[..n], &mut bounds[..n], counts);
             } else {
-                // Nothing is skipped: every bound is 0.
+                // Nothing is skipped (no cutoff, or no ray traced): every bound is 0.
                 self.sample_row(s, t, &mut colours[..n], counts);
             }
             for ((o, &c), &b) in out.iter_mut().zip(&colours).zip(&bounds) {
