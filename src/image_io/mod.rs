@@ -5,6 +5,7 @@
 
 mod animated;
 mod atomic;
+mod plain_ppm;
 
 use std::io::{BufRead, BufWriter, Cursor, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
@@ -261,15 +262,11 @@ pub fn encode_rgb8(
     let raw = image.as_raw();
     let rgb = ExtendedColorType::Rgb8;
     let result = match format {
-        Format::Ppm { binary } => {
-            let encoding = if binary {
-                SampleEncoding::Binary
-            } else {
-                SampleEncoding::Ascii
-            };
-            PnmEncoder::new(out)
-                .with_subtype(PnmSubtype::Pixmap(encoding))
-                .write_image(raw, w, h, rgb)
+        Format::Ppm { binary: true } => PnmEncoder::new(out)
+            .with_subtype(PnmSubtype::Pixmap(SampleEncoding::Binary))
+            .write_image(raw, w, h, rgb),
+        Format::Ppm { binary: false } => {
+            plain_ppm::write(raw, w, h, out).map_err(image::ImageError::IoError)
         }
         Format::Png => PngEncoder::new(out).write_image(raw, w, h, rgb),
         Format::Bmp => BmpEncoder::new(&mut &mut *out).write_image(raw, w, h, rgb),
