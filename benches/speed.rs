@@ -1,15 +1,15 @@
 //! Speed benchmarks (`cargo bench`): the intersection kernel, the fast tracer's rays
 //! of one and two bounces, the fast tracer's build (hierarchy and grids), the walk of
-//! incoherent rays through the hierarchy alone, whole frames
-//! of the peers' scenes, and the viewer's views and screen conversions. Compare runs of
-//! one sitting, as ratios.
+//! incoherent rays through the hierarchy alone, whole frames of the peers' scenes, and
+//! the viewer's views, refinements and screen conversions. Compare runs of one
+//! sitting, as ratios.
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{DVec3, Vec3};
 use whitted::intersect::roots;
-use whitted::render::{render, RenderControl};
+use whitted::render::{accumulate, render, RenderControl};
 use whitted::scene::{hw3_scene, many_scene, HW3_DEFAULT_SEED};
 use whitted::speed::SecondaryWalk;
 use whitted::trace::fast::FastTracer;
@@ -153,6 +153,28 @@ fn viewer(c: &mut Criterion) {
             worker::run(&job, &mut cache, &mut buffers, &|r| drop(black_box(r))).expect("renders")
         })
     });
+
+    // The window's refinements of a still view after its first pass: sample 1 of
+    // every pixel, then samples 2 and 3 (the passes of one and two samples a pixel).
+    let mut still = scene.clone();
+    still.image.spp = Some(16);
+    let settings = still.settings();
+    let camera = still.camera(w, h).expect("camera");
+    let tracer = FastTracer::new(&still, &camera, settings.quality.max_depth);
+    let mut sums = vec![Vec3::ZERO; (w * h) as usize];
+    for samples in [1..2, 2..4] {
+        let name = format!(
+            "refine_hw3_1280x720_samples_{}_{}",
+            samples.start, samples.end
+        );
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let control = RenderControl::default();
+                accumulate(&tracer, &settings, samples.clone(), &mut sums, &control)
+                    .expect("renders")
+            })
+        });
+    }
 
     let image = render(&scene, &scene.settings(), &RenderControl::default())
         .expect("renders")

@@ -14,38 +14,9 @@ use crate::trace::RayCounts;
 /// Rows per unit of parallel work.
 pub(super) const BAND_ROWS: usize = 8;
 
-/// Runs `pixel(i, j, state, counts)` for every pixel of `area` (image pixels, `j` from
-/// the bottom) on the thread pool of `settings`. `states` holds one item for each pixel
-/// of the area, row 0 at the bottom of the area. Progress counts `samples` per pixel.
-pub(super) fn for_each_pixel<T, F>(
-    settings: &Settings,
-    area: Region,
-    states: &mut [T],
-    samples: u64,
-    control: &RenderControl,
-    pixel: F,
-) -> Result<RayCounts, RenderError>
-where
-    T: Send,
-    F: Fn(u32, u32, &mut T, &mut RayCounts) + Sync,
-{
-    for_each_row(
-        settings,
-        area,
-        states,
-        1,
-        samples,
-        control,
-        |j, row, counts| {
-            for (a, state) in row.iter_mut().enumerate() {
-                pixel(area.x + a as u32, j, state, counts);
-            }
-        },
-    )
-}
-
 /// Runs `row(j, states, counts)` for every row of `area` (`j` from the bottom of the
-/// image) with the states of its pixels; see [`for_each_pixel`].
+/// image) with the states of its pixels (`per_pixel` items each, row 0 at the bottom of
+/// the area) on the thread pool of `settings`. Progress counts `samples` per pixel.
 pub(crate) fn for_each_row<T, F>(
     settings: &Settings,
     area: Region,

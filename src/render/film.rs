@@ -2,11 +2,13 @@
 //! `s = (i + sx)/W`, `t = (j + sy)/H`, with `j` counted from the bottom and the
 //! offsets of [`crate::sampling`]. One sample a pixel is the pixel's centre.
 
+use std::ops::Range;
+
 use glam::Vec3;
 
 use crate::sampling::{PixelStrata, Strata};
 use crate::settings::{Region, Settings};
-use crate::trace::{in_pairs, FilmRect, RayCounts, SampleTracer};
+use crate::trace::{in_pairs, FilmRect, RayCounts, SampleTracer, RUN};
 
 /// The film abscissae of the centres of the area's columns: `film`'s `s` for one
 /// sample a pixel (the same values), worked out once.
@@ -28,7 +30,7 @@ pub(crate) fn centre_height(settings: &Settings, j: u32) -> f32 {
     (j as f32 + 0.5) / settings.height as f32
 }
 
-/// Where on the film each sample of a render lands ([`Film::at`]), with what that
+/// Where on the film each sample of a render lands ([`FilmPixel::at`]), with what that
 /// takes of the settings worked out once.
 pub(crate) struct Film {
     width: f32,
@@ -47,12 +49,6 @@ impl Film {
         }
     }
 
-    /// The film position of sample `k` of pixel `(i, j)`.
-    #[inline]
-    pub(crate) fn at(&self, i: u32, j: u32, k: u32) -> (f32, f32) {
-        self.pixel(i, j).at(k)
-    }
-
     /// The film positions of pixel `(i, j)`'s samples ([`FilmPixel::at`]).
     #[inline]
     fn pixel(&self, i: u32, j: u32) -> FilmPixel<'_> {
@@ -63,13 +59,19 @@ impl Film {
         }
     }
 
-    /// The film rectangle of pixel `(i, j)`: every position [`Film::at`] gives its
+    /// The film rectangle of pixel `(i, j)`: every position [`FilmPixel::at`] gives its
     /// samples lies in it (`i + sx` rounds to at most `i + 1`, and the division keeps
     /// the order).
     fn pixel_area(&self, i: u32, j: u32) -> FilmRect {
-        let (i, j) = (i as f32, j as f32);
+        self.pixels_area(i, 1, j)
+    }
+
+    /// The film rectangle of the `n` pixels from `(i, j)` rightwards, which holds each
+    /// one's [`Film::pixel_area`] (the division keeps the order).
+    fn pixels_area(&self, i: u32, n: u32, j: u32) -> FilmRect {
+        let (i, n, j) = (i as f32, n as f32, j as f32);
         FilmRect {
-            s: [i / self.width, (i + 1.0) / self.width],
+            s: [i / self.width, (i + n) / self.width],
             t: [j / self.height, (j + 1.0) / self.height],
         }
     }
@@ -125,6 +127,56 @@ pub(crate) fn each_sample<T: SampleTracer + ?Sized>(
 /// The most samples handed to a tracer at once.
 const CHUNK: usize = 16;
 
+/// Samples `ks` of the pixels `columns` of row `j`, each pixel's in the order of `ks`,
+/// each given to `each(a, k, value)` with the pixel's place `a` in `columns`: from
+/// four samples a pixel on, a pixel at a time ([`each_sample`]); with fewer, the
+/// samples of [`RUN`] (about) neighbouring pixels at once through
+/// [`SampleTracer::sample_bounded_in`] the rectangle of their squares, so that the
+/// tracer shares work between neighbours as it does between a pixel's samples (two
+/// samples a pixel, a pixel at a time in pairs, cost 2.9 times one sample a pixel on
+/// hw3).
+pub(crate) fn each_sample_of_row<T: SampleTracer + ?Sized>(
+    tracer: &T,
+    film: &Film,
+    columns: &[u32],
+    j: u32,
+    ks: Range<u32>,
+    counts: &mut RayCounts,
+    mut each: impl FnMut(usize, u32, (Vec3, f32)),
+) {
+    let per_pixel = ks.len();
+    if per_pixel == 0 || per_pixel >= 4 {
+        for (a, &i) in columns.iter().enumerate() {
+            each_sample(tracer, film, (i, j), ks.clone(), counts, |k, v| {
+                each(a, k, v);
+            });
+        }
+        return;
+    }
+    let group = RUN.div_ceil(per_pixel);
+    let mut at = [(0.0, 0.0); CHUNK];
+    let mut values = [(Vec3::ZERO, 0.0); CHUNK];
+    for (g, pixels) in columns.chunks(group).enumerate() {
+        let mut m = 0;
+        for &i in pixels {
+            let pixel = film.pixel(i, j);
+            for k in ks.clone() {
+                at[m] = pixel.at(k);
+                m += 1;
+            }
+        }
+        let (least, most) = pixels
+            .iter()
+            .fold((u32::MAX, 0), |(l, h), &i| (l.min(i), h.max(i)));
+        let area = film.pixels_area(least, most - least + 1, j);
+        tracer.sample_bounded_in(area, &at[..m], &mut values[..m], counts);
+        let samples = (0..pixels.len()).flat_map(|a| ks.clone().map(move |k| (a, k)));
+        for ((a, k), &value) in samples.zip(&values[..m]) {
+            each(g * group + a, k, value);
+        }
+    }
+}
+
 /// The next [`CHUNK`] samples of `ks` (or what is left of them) of pixel `(i, j)`,
 /// traced through [`SampleTracer::sample_bounded_in`] the pixel's square: their
 /// indices, their (colour, cutoff bound) and how many. (Out of line, and handing the
@@ -161,7 +213,7 @@ mod tests {
     use super::*;
     use crate::sampling::sample_offset;
 
-    /// `Film::at` is SPEC §2's `s = (i + sx)/W`, `t = (j + sy)/H` with the offsets of
+    /// `FilmPixel::at` is SPEC §2's `s = (i + sx)/W`, `t = (j + sy)/H` with the offsets of
     /// `sample_offset`, to the bit, and every sample of a pixel lies in the pixel's
     /// square, whose corners are the film positions of the pixel's corners: over sizes
     /// up to 8192 across, 1 to 64 samples, and the pixels at the edges.
@@ -188,7 +240,7 @@ mod tests {
                 for k in 0..settings.quality.spp {
                     let (sx, sy) = sample_offset(i, j, k, settings.quality.spp, settings.seed);
                     let want = ((i as f32 + sx) / wf, (j as f32 + sy) / hf);
-                    let (s, t) = film.at(i, j, k);
+                    let (s, t) = film.pixel(i, j).at(k);
                     assert_eq!(
                         (s.to_bits(), t.to_bits()),
                         (want.0.to_bits(), want.1.to_bits())
@@ -200,5 +252,59 @@ mod tests {
             }
         }
         assert!(inside > 20_000, "{inside} samples");
+    }
+
+    /// The samples of a row's pixels through `each_sample_of_row` are each sample
+    /// alone (`sample_bounded` at `FilmPixel::at`), to the bit, each pixel's in the
+    /// order of `ks`, with the same ray counts: hw3 at 64×36 and 1280×720 (groups in
+    /// one cell of the eye grid, in the sky and across cells), whole rows and a
+    /// preview's lattice of every third column, one to five samples a pixel from the
+    /// first and from later ones.
+    #[test]
+    fn a_row_s_samples_are_each_sample_alone() {
+        use crate::trace::fast::FastTracer;
+        let scene = crate::scene::hw3_scene(crate::scene::HW3_DEFAULT_SEED);
+        let bits = |(c, b): (Vec3, f32)| (c.to_array().map(f32::to_bits), b.to_bits());
+        let mut groups = 0;
+        for (w, h) in [(64, 36), (1280, 720)] {
+            let camera = scene.camera(w, h).unwrap();
+            let tracer = FastTracer::new(&scene, &camera, 5);
+            let mut settings = Settings::default();
+            (settings.width, settings.height, settings.quality.spp) = (w, h, 8);
+            let film = Film::new(&settings);
+            let whole: Vec<u32> = (0..w).collect();
+            let lattice: Vec<u32> = (1..w).step_by(3).collect();
+            for columns in [&whole, &lattice] {
+                for ks in [0..1, 1..2, 0..2, 2..4, 0..3, 3..8] {
+                    for j in [0, h / 3, h / 2, h - 1] {
+                        let (mut shared, mut alone) = (RayCounts::default(), RayCounts::default());
+                        let mut got = Vec::new();
+                        let each = |a, k, v| got.push((a, k, bits(v)));
+                        each_sample_of_row(
+                            &tracer,
+                            &film,
+                            columns,
+                            j,
+                            ks.clone(),
+                            &mut shared,
+                            each,
+                        );
+                        // Stable: each pixel's samples stay in the order they came in.
+                        got.sort_by_key(|&(a, _, _)| a);
+                        let mut want = Vec::new();
+                        for (a, &i) in columns.iter().enumerate() {
+                            for k in ks.clone() {
+                                let (s, t) = film.pixel(i, j).at(k);
+                                want.push((a, k, bits(tracer.sample_bounded(s, t, &mut alone))));
+                            }
+                        }
+                        assert!(got == want, "{w}x{h} row {j}, samples {ks:?}");
+                        assert_eq!(shared, alone);
+                        groups += columns.len().div_ceil(RUN.div_ceil(ks.len().min(4)));
+                    }
+                }
+            }
+        }
+        assert!(groups > 3000, "{groups} groups");
     }
 }

@@ -29,7 +29,7 @@ use crate::trace::reference::ReferenceTracer;
 use crate::trace::{RayCounts, SampleTracer};
 use adaptive::adaptive;
 use bands::{for_each_row, for_each_row_of_bytes, in_pool, BAND_ROWS};
-use film::{centre_height, each_sample, pixel_centres, Film};
+use film::{centre_height, each_sample_of_row, pixel_centres, Film};
 
 pub use adaptive::first_pass_samples;
 use frame::bytes_of_row;
@@ -406,6 +406,7 @@ fn render_with<T: SampleTracer>(
                 (0..n).into_par_iter().map(|_| Vec3::ZERO).collect()
             })?;
             let centres = pixel_centres(settings, area);
+            let columns: Vec<u32> = (area.x..area.x + area.width).collect();
             let rays = for_each_row(
                 settings,
                 area,
@@ -422,13 +423,13 @@ fn render_with<T: SampleTracer>(
                         mend_non_finite(row);
                         return;
                     }
-                    for (a, p) in row.iter_mut().enumerate() {
-                        let i = area.x + a as u32;
-                        let mut sum = Vec3::ZERO;
-                        each_sample(tracer, &film, (i, j), 0..spp, counts, |_, (c, _)| {
-                            sum += c;
-                        });
-                        *p = pixel_value(sum, spp);
+                    // The sums in the pixels' places, then their values.
+                    row.fill(Vec3::ZERO);
+                    each_sample_of_row(tracer, &film, &columns, j, 0..spp, counts, {
+                        |a, _, (c, _)| row[a] += c
+                    });
+                    for p in row.iter_mut() {
+                        *p = pixel_value(*p, spp);
                     }
                 },
             )?;
@@ -444,6 +445,7 @@ fn render_with<T: SampleTracer>(
                 (0..n).into_par_iter().map(|_| (Vec3::ZERO, 0.0)).collect()
             })?;
             let centres = pixel_centres(settings, area);
+            let columns: Vec<u32> = (area.x..area.x + area.width).collect();
             let rays = for_each_row(
                 settings,
                 area,
@@ -457,13 +459,12 @@ fn render_with<T: SampleTracer>(
                         let t = centre_height(settings, j);
                         return tracer.sample_row_bounded(&centres, t, row, counts);
                     }
-                    for (a, (sum, bound)) in row.iter_mut().enumerate() {
-                        let i = area.x + a as u32;
-                        each_sample(tracer, &film, (i, j), 0..spp, counts, |_, (c, b)| {
-                            *sum += c;
-                            *bound += b;
-                        });
-                    }
+                    each_sample_of_row(tracer, &film, &columns, j, 0..spp, counts, {
+                        |a, _, (c, b)| {
+                            row[a].0 += c;
+                            row[a].1 += b;
+                        }
+                    });
                 },
             )?;
             let (pixels, bounds) = in_pool(settings, || {

@@ -6,11 +6,11 @@ use std::ops::Range;
 
 use glam::Vec3;
 
-use super::bands::{for_each_pixel, for_each_row};
-use super::film::{centre_height, centres_of, each_sample, Film};
+use super::bands::for_each_row;
+use super::film::{centre_height, centres_of, each_sample_of_row, Film};
 use super::{RenderControl, RenderError};
 use crate::settings::Settings;
-use crate::trace::{in_pairs, RayCounts, SampleTracer};
+use crate::trace::{RayCounts, SampleTracer};
 
 /// Sample 0 of the pixels `columns` (film abscissae `centres`, from [`centres_of`]) of
 /// row `j` into `out`, as [`accumulate`] of sample 0 sums it: the pixel centres a row
@@ -28,15 +28,10 @@ pub(crate) fn first_samples<T: SampleTracer + ?Sized>(
         tracer.sample_row(centres, centre_height(settings, j), out, counts);
         return;
     }
-    // Two pixels at a time, each sum from zero as `accumulate` starts it.
+    // Each sum from zero as `accumulate` starts it.
     let film = Film::new(settings);
-    let at = columns
-        .iter()
-        .zip(out)
-        .map(|(&i, sum)| (sum, film.at(i, j, 0)));
-    in_pairs(tracer, at, counts, |sum, (c, _)| {
-        *sum = Vec3::ZERO;
-        *sum += c;
+    each_sample_of_row(tracer, &film, columns, j, 0..1, counts, |a, _, (c, _)| {
+        out[a] = Vec3::ZERO + c;
     });
 }
 
@@ -58,20 +53,15 @@ pub fn accumulate<T: SampleTracer + ?Sized>(
     let n = samples.len() as u64;
     let afresh = samples.start == 0;
     let film = Film::new(settings);
-    for_each_pixel(settings, area, sums, n, control, |i, j, sum, counts| {
+    let columns: Vec<u32> = (area.x..area.x + area.width).collect();
+    for_each_row(settings, area, sums, 1, n, control, |j, row, counts| {
         if afresh {
-            *sum = Vec3::ZERO;
+            row.fill(Vec3::ZERO);
         }
-        each_sample(
-            tracer,
-            &film,
-            (i, j),
-            samples.clone(),
-            counts,
-            |_, (c, _)| {
-                *sum += c;
-            },
-        );
+        let ks = samples.clone();
+        each_sample_of_row(tracer, &film, &columns, j, ks, counts, {
+            |a, _, (c, _)| row[a] += c
+        });
     })
 }
 

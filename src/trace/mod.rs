@@ -6,6 +6,8 @@ pub mod fast;
 pub mod reference;
 mod row;
 
+pub(crate) use row::RUN;
+
 use glam::Vec3;
 
 /// Rays cast while rendering, by kind.
@@ -34,7 +36,8 @@ impl RayCounts {
 }
 
 /// A rectangle of the film, `[s[0], s[1]] × [t[0], t[1]]` (`t` from the bottom): the
-/// square of one pixel, which all its samples lie in.
+/// square of one pixel, which all its samples lie in, or the squares of a few pixels
+/// of a row.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FilmRect {
     /// The least and the greatest abscissa.
@@ -68,8 +71,9 @@ pub trait SampleTracer: Sync {
     }
 
     /// `out[n] = sample_bounded(at[n].0, at[n].1)` for film positions `at` that all lie
-    /// in `area` (the samples of one pixel): the same values as one by one (a tracer
-    /// may share work between the samples of one small area).
+    /// in `area` (the samples of one pixel, or of a few neighbours in a row): the same
+    /// values as one by one (a tracer may share work between the samples of one small
+    /// area).
     fn sample_bounded_in(
         &self,
         area: FilmRect,
