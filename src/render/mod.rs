@@ -29,7 +29,7 @@ use crate::trace::reference::ReferenceTracer;
 use crate::trace::{RayCounts, SampleTracer};
 use adaptive::adaptive;
 use bands::{for_each_row, for_each_row_of_bytes, in_pool, BAND_ROWS};
-use film::{centre_height, each_sample_of_row, pixel_centres, Film};
+use film::{centre_height, centres_of, each_sample_of_row, pixel_centres, Film};
 
 pub use adaptive::first_pass_samples;
 use frame::bytes_of_row;
@@ -405,8 +405,8 @@ fn render_with<T: SampleTracer>(
             let mut pixels: Vec<Vec3> = in_pool(settings, || {
                 (0..n).into_par_iter().map(|_| Vec3::ZERO).collect()
             })?;
-            let centres = pixel_centres(settings, area);
             let columns: Vec<u32> = (area.x..area.x + area.width).collect();
+            let centres = centres_of(settings, &columns);
             let rays = for_each_row(
                 settings,
                 area,
@@ -444,8 +444,8 @@ fn render_with<T: SampleTracer>(
             let mut acc: Vec<(Vec3, f32)> = in_pool(settings, || {
                 (0..n).into_par_iter().map(|_| (Vec3::ZERO, 0.0)).collect()
             })?;
-            let centres = pixel_centres(settings, area);
             let columns: Vec<u32> = (area.x..area.x + area.width).collect();
+            let centres = centres_of(settings, &columns);
             let rays = for_each_row(
                 settings,
                 area,
